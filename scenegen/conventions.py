@@ -1,0 +1,139 @@
+"""Every convention of the project, stated once, and the one conversion to each foreign one.
+
+Internal conventions (used everywhere in scenegen and recon_eval):
+
+* Camera axes: OpenCV. +x right, +y down, +z forward (the optical axis). A pose is
+  ``cam_from_world`` (``x_cam = R x_world + t``), see :mod:`scenegen.pose`.
+* Units: metres; radians inside the code, degrees only at the user's edges (spec fields and result
+  fields named ``*_deg``).
+* Pixels: OpenCV. The CENTRE of the top-left pixel is (u, v) = (0, 0); u grows to the right along
+  columns, v down along rows; the image spans [-0.5, W - 0.5] x [-0.5, H - 0.5].
+* Depth is z along the optical axis (``depth_z``); range is the Euclidean distance from the optical
+  centre (``range``). ``range = depth_z * |(x, y, 1)|`` for the z = 1 ray (x, y, 1).
+* Quaternions are (w, x, y, z), scalar first (COLMAP's order).
+* Texture UVs: u along texture columns, v along rows with v = 0 at the top row (image row 0).
+
+Foreign conventions, one function (or constant) each:
+
+* COLMAP pixels: the top-left pixel's centre is (0.5, 0.5): ``colmap = opencv + 0.5``.
+* Mitsuba film: sample position s in [0, 1]^2 over the image, pixel i covers [i, i + 1] in film
+  pixel units, so ``u = s_x * W - 0.5``. Mitsuba camera axes: +x LEFT, +y UP, +z forward (a 180
+  degree rotation about z from OpenCV). Its ``to_world`` is camera-to-world.
+* OpenGL / NeRF (instant-ngp, nerfstudio ``transforms.json``): camera-to-world 4x4 with camera axes
+  +x right, +y up, +z backward (the camera looks down -z).
+* Blender: a camera object's ``matrix_world`` uses the OpenGL camera axes; Blender's world is the
+  same right-handed Z-up world as ours, so no world change is needed.
+* COLMAP poses: ``cam_from_world`` as a wxyz quaternion and a translation (images.txt).
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from scenegen.pose import Rigid3
+
+# --- camera axes -----------------------------------------------------------------------------
+#: x_mitsuba_cam = MITSUBA_FROM_OPENCV_CAM @ x_opencv_cam (x left, y up, z forward).
+MITSUBA_FROM_OPENCV_CAM = np.diag([-1.0, -1.0, 1.0])
+#: x_opengl_cam = OPENGL_FROM_OPENCV_CAM @ x_opencv_cam (x right, y up, z backward).
+OPENGL_FROM_OPENCV_CAM = np.diag([1.0, -1.0, -1.0])
+
+
+def mitsuba_to_world(cam_from_world: Rigid3) -> np.ndarray:
+    """Mitsuba sensor ``to_world`` (4x4, Mitsuba camera -> world) for an OpenCV ``cam_from_world``."""
+    world_from_cam = cam_from_world.inverse()
+    T = np.eye(4)
+    T[:3, :3] = world_from_cam.R @ MITSUBA_FROM_OPENCV_CAM.T
+    T[:3, 3] = world_from_cam.t
+    return T
+
+
+def cam_from_world_from_mitsuba(to_world) -> Rigid3:
+    """Inverse of :func:`mitsuba_to_world`."""
+    T = np.asarray(to_world, dtype=np.float64)
+    return Rigid3(T[:3, :3] @ MITSUBA_FROM_OPENCV_CAM, T[:3, 3]).inverse()
+
+
+def opengl_cam_to_world(cam_from_world: Rigid3) -> np.ndarray:
+    """OpenGL/NeRF camera-to-world 4x4 (``transform_matrix`` of transforms.json); also Blender's
+    camera ``matrix_world``."""
+    world_from_cam = cam_from_world.inverse()
+    T = np.eye(4)
+    T[:3, :3] = world_from_cam.R @ OPENGL_FROM_OPENCV_CAM.T
+    T[:3, 3] = world_from_cam.t
+    return T
+
+
+def cam_from_world_from_opengl(cam_to_world) -> Rigid3:
+    """Inverse of :func:`opengl_cam_to_world`."""
+    T = np.asarray(cam_to_world, dtype=np.float64)
+    return Rigid3(T[:3, :3] @ OPENGL_FROM_OPENCV_CAM, T[:3, 3]).inverse()
+
+
+# Blender cameras use the OpenGL camera axes in a Z-up world identical to ours.
+blender_matrix_world = opengl_cam_to_world
+cam_from_world_from_blender = cam_from_world_from_opengl
+
+
+# --- quaternions and COLMAP poses ---------------------------------------------------------------
+def quat_wxyz_from_matrix(R) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) with w >= 0 for a rotation matrix."""
+    q = Rotation.from_matrix(np.asarray(R, float)).as_quat(scalar_first=True)
+    return q if q[0] >= 0 else -q
+
+
+def matrix_from_quat_wxyz(q_wxyz) -> np.ndarray:
+    """Rotation matrix from a (w, x, y, z) quaternion (normalised first)."""
+    q = np.asarray(q_wxyz, dtype=np.float64)
+    if q.shape != (4,) or not np.all(np.isfinite(q)) or np.linalg.norm(q) == 0:
+        raise ValueError(f"quaternion must be 4 finite numbers, not all zero; got {q_wxyz!r}")
+    return Rotation.from_quat(q, scalar_first=True).as_matrix()
+
+
+def colmap_pose(cam_from_world: Rigid3) -> tuple[np.ndarray, np.ndarray]:
+    """(qvec_wxyz, tvec) as written in COLMAP's images.txt (cam_from_world)."""
+    return quat_wxyz_from_matrix(cam_from_world.R), cam_from_world.t.copy()
+
+
+def cam_from_world_from_colmap(qvec_wxyz, tvec) -> Rigid3:
+    return Rigid3(matrix_from_quat_wxyz(qvec_wxyz), tvec)
+
+
+# --- pixels -----------------------------------------------------------------------------------
+def colmap_from_opencv_pixels(uv):
+    """COLMAP image coordinates (top-left pixel centre at 0.5) from OpenCV pixels."""
+    return np.asarray(uv, dtype=np.float64) + 0.5
+
+
+def opencv_from_colmap_pixels(uv):
+    return np.asarray(uv, dtype=np.float64) - 0.5
+
+
+def opencv_pixel_from_film(sample, size):
+    """OpenCV pixel from Mitsuba's film sample position in [0, 1]^2 over the full image.
+
+    Works on numpy and Dr.Jit values alike (only arithmetic). ``size`` is (W, H).
+    """
+    return sample[0] * size[0] - 0.5, sample[1] * size[1] - 0.5
+
+
+def film_from_opencv_pixel(uv, size):
+    """Mitsuba film sample position in [0, 1]^2 for an OpenCV pixel (inverse of the above)."""
+    return (uv[0] + 0.5) / size[0], (uv[1] + 0.5) / size[1]
+
+
+def pixel_centers(width: int, height: int) -> np.ndarray:
+    """(H, W, 2) float64 OpenCV coordinates of every pixel centre: [v, u] -> (u, v) = (u, v)."""
+    u, v = np.meshgrid(np.arange(width, dtype=np.float64), np.arange(height, dtype=np.float64))
+    return np.stack([u, v], axis=-1)
+
+
+# --- depth vs range ---------------------------------------------------------------------------
+def range_from_depth_z(depth_z, rays_z1):
+    """Range (distance from the optical centre) from z-depth along z = 1 rays (..., 3)."""
+    return np.asarray(depth_z) * np.linalg.norm(np.asarray(rays_z1), axis=-1)
+
+
+def depth_z_from_range(range_m, rays_z1):
+    """z-depth from range along z = 1 rays (..., 3) (x, y, 1)."""
+    return np.asarray(range_m) / np.linalg.norm(np.asarray(rays_z1), axis=-1)
