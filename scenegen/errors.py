@@ -1,0 +1,60 @@
+"""Errors a user can fix: they name the file, the line and the field, and say what was expected.
+
+The CLI prints ``str(err)`` and exits with status 2 (no traceback). Any stage that works from a
+parsed spec (texture generation, mesh loading, rendering) can point back into the YAML through the
+``where`` recorded on the spec's dataclasses: ``raise SpecError.at(obj.where, "mesh has no faces")``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Where:
+    """A place in a spec file: ``file`` as given by the user, ``line`` 1-based (or None),
+    ``field`` a path such as ``objects[2].transform.rotation_deg`` (or None)."""
+
+    file: str | None = None
+    line: int | None = None
+    field: str | None = None
+
+    def __str__(self) -> str:
+        head = ":".join(str(p) for p in (self.file, self.line) if p is not None)
+        return ": ".join(p for p in (head, self.field or "") if p)
+
+
+class SpecError(Exception):
+    """A scene spec that cannot be used, and why.
+
+    ``str(err)`` reads ``scene.yaml:14: objects[2].transform.rotation_deg: expected 3 numbers
+    (degrees), got 'abc'``; parts that are unknown are left out.
+    """
+
+    def __init__(self, message: str, *, file: str | None = None, line: int | None = None,
+                 field: str | None = None):
+        super().__init__(message)
+        self.message = message  # what was expected (and what was found)
+        self.file = file  # the spec file as the user named it, or '<string>'
+        self.line = line  # 1-based line in that file, or None
+        self.field = field  # field path, e.g. 'cameras.left.fx', or None
+
+    @classmethod
+    def at(cls, where: Where | None, message: str) -> "SpecError":
+        """An error at a recorded place (``where`` may be None)."""
+        w = where or Where()
+        return cls(message, file=w.file, line=w.line, field=w.field)
+
+    @property
+    def where(self) -> Where:
+        return Where(self.file, self.line, self.field)
+
+    def __str__(self) -> str:
+        prefix = str(self.where)
+        return f"{prefix}: {self.message}" if prefix else self.message
+
+    def __reduce__(self):  # keep the keyword fields through pickling (multiprocessing)
+        return (_rebuild, (self.message, self.file, self.line, self.field))
+
+
+def _rebuild(message, file, line, field):
+    return SpecError(message, file=file, line=line, field=field)

@@ -1,0 +1,109 @@
+"""Pick a Mitsuba variant and a libLLVM that works, before Dr.Jit is imported.
+
+Dr.Jit's LLVM back end JIT-compiles through a system libLLVM found at run time. Debian's
+libLLVM 15 aborts the whole process on the first kernel using min/max (``Cannot select ...
+fminimum``, uncatchable) and 14 leaves the back end inactive, so only 16 or newer is used, chosen
+here explicitly through ``DRJIT_LIBLLVM_PATH`` (see docs/conventions.md and shared notes).
+Without one, ``auto`` falls back to ``scalar_rgb`` with a warning.
+"""
+from __future__ import annotations
+
+import glob
+import os
+import re
+import sys
+import warnings
+
+MIN_LLVM_MAJOR = 16
+VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
+_SEARCH = (
+    "/usr/lib/x86_64-linux-gnu/libLLVM.so.*", "/usr/lib/x86_64-linux-gnu/libLLVM-*.so*",
+    "/usr/lib/aarch64-linux-gnu/libLLVM.so.*", "/usr/lib/aarch64-linux-gnu/libLLVM-*.so*",
+    "/usr/lib/llvm-*/lib/libLLVM*.so*", "/usr/local/lib/libLLVM*.so*", "/opt/homebrew/opt/llvm/lib/libLLVM.dylib",
+)
+
+
+class BackendError(RuntimeError):
+    """The requested variant cannot run on this machine."""
+
+
+def _llvm_major(path: str) -> int | None:
+    m = re.search(r"libLLVM[-.]?(?:so\.)?(\d+)", os.path.basename(path))
+    return int(m.group(1)) if m else None
+
+
+def find_libllvm() -> str | None:
+    """The newest libLLVM >= 16 on this machine, or None."""
+    found = []
+    for pattern in _SEARCH:
+        for path in glob.glob(pattern):
+            major = _llvm_major(path)
+            if major is not None and major >= MIN_LLVM_MAJOR and os.path.isfile(path):
+                found.append((major, path))
+    return max(found)[1] if found else None
+
+
+def _configure_llvm() -> bool:
+    """Point Dr.Jit at a good libLLVM if it has not been imported yet. True if one is set."""
+    current = os.environ.get("DRJIT_LIBLLVM_PATH")
+    if current and (_llvm_major(current) or MIN_LLVM_MAJOR) >= MIN_LLVM_MAJOR and os.path.isfile(current):
+        return True
+    if "drjit" in sys.modules:
+        return current is not None
+    path = find_libllvm()
+    if path is None:
+        return False
+    os.environ["DRJIT_LIBLLVM_PATH"] = path
+    return True
+
+
+def llvm_available() -> bool:
+    """True if Dr.Jit's LLVM back end runs with a libLLVM >= 16."""
+    if not _configure_llvm():
+        return False
+    import drjit as dr
+
+    try:
+        return dr.has_backend(dr.JitBackend.LLVM) and dr.detail.llvm_version()[0] >= MIN_LLVM_MAJOR
+    except Exception:  # an inactive back end raises on query
+        return False
+
+
+def cuda_available() -> bool:
+    _configure_llvm()
+    import drjit as dr
+
+    try:
+        return bool(dr.has_backend(dr.JitBackend.CUDA))
+    except Exception:
+        return False
+
+
+def resolve_variant(requested: str = "auto") -> str:
+    """The variant to run: ``auto`` takes cuda_ad_rgb, then llvm_ad_rgb, then scalar_rgb."""
+    if requested not in VARIANTS:
+        raise BackendError(f"variant must be one of {VARIANTS}, got {requested!r}")
+    if requested == "auto":
+        if cuda_available():
+            return "cuda_ad_rgb"
+        if llvm_available():
+            return "llvm_ad_rgb"
+        warnings.warn(
+            "no working libLLVM >= 16 found (install Debian's libllvm19 or set DRJIT_LIBLLVM_PATH); "
+            "falling back to scalar_rgb, which is 40-60x slower", RuntimeWarning, stacklevel=2)
+        return "scalar_rgb"
+    if requested == "llvm_ad_rgb" and not llvm_available():
+        raise BackendError("llvm_ad_rgb needs libLLVM >= 16 (Debian: apt-get install libllvm19, or set "
+                           "DRJIT_LIBLLVM_PATH); libLLVM 15 aborts the process and is never used")
+    if requested == "cuda_ad_rgb" and not cuda_available():
+        raise BackendError("cuda_ad_rgb needs an NVIDIA GPU with a working CUDA driver")
+    return requested
+
+
+def load_mitsuba(variant: str = "auto"):
+    """Import Mitsuba with a safe libLLVM and the resolved variant set; returns the module."""
+    resolved = resolve_variant(variant)
+    import mitsuba as mi
+
+    mi.set_variant(resolved)
+    return mi

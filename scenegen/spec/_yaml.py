@@ -1,0 +1,368 @@
+"""Typed, located access to a YAML node tree (SafeLoader only).
+
+The YAML text is composed, not constructed, so every value keeps its line. ``Node`` wraps one
+value with its field path; its ``as_*`` readers check the type and range and raise
+:class:`~scenegen.errors.SpecError` naming file, line and field. ``Fields`` wraps a mapping,
+rejects unknown keys (with a difflib suggestion) and hands out required / optional members.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import yaml
+
+from scenegen.errors import SpecError, Where
+
+_NUMBER_RE = re.compile(r"^[-+]?(\d[\d_]*\.?[\d_]*|\.\d[\d_]*)([eE][-+]?\d+)?$")
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+
+
+def suggest(word: str, choices: Iterable[str]) -> str:
+    """' (did you mean 'x'?)' for the closest choice, or ''."""
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def quoted_list(choices: Iterable) -> str:
+    return ", ".join(repr(c) for c in choices)
+
+
+class Document:
+    """A composed YAML document: the loader (for scalar construction) and the file name."""
+
+    def __init__(self, text: str, file: str, base_dir: Path):
+        self.file = file
+        self.base_dir = base_dir
+        self.loader = yaml.SafeLoader(text)
+        try:
+            try:
+                root = self.loader.get_single_node()
+            finally:
+                self.loader.dispose()
+        except yaml.MarkedYAMLError as e:
+            mark = e.problem_mark or e.context_mark
+            what = " ".join(p for p in (e.context, e.problem) if p)
+            raise SpecError(f"invalid YAML: {what}", file=file,
+                            line=mark.line + 1 if mark else None) from None
+        except yaml.YAMLError as e:
+            raise SpecError(f"invalid YAML: {e}", file=file) from None
+        self.root = Node(self, root, "")
+
+    def where(self, node: yaml.Node | None, path: str) -> Where:
+        line = node.start_mark.line + 1 if node is not None else None
+        return Where(self.file, line, path or None)
+
+
+class Node:
+    """One YAML value with its field path."""
+
+    __slots__ = ("doc", "node", "path")
+
+    def __init__(self, doc: Document, node: yaml.Node | None, path: str):
+        self.doc, self.node, self.path = doc, node, path
+
+    # -- location and errors ------------------------------------------------------------------
+    @property
+    def where(self) -> Where:
+        return self.doc.where(self.node, self.path)
+
+    @property
+    def line(self) -> int | None:
+        return self.where.line
+
+    def error(self, message: str) -> SpecError:
+        return SpecError.at(self.where, message)
+
+    def child(self, node: yaml.Node, key: str | int) -> "Node":
+        if isinstance(key, int):
+            return Node(self.doc, node, f"{self.path}[{key}]")
+        return Node(self.doc, node, f"{self.path}.{key}" if self.path else key)
+
+    # -- type tests ------------------------------------------------------------------------------
+    @property
+    def is_null(self) -> bool:
+        return self.node is None or (isinstance(self.node, yaml.ScalarNode)
+                                     and self.node.tag == "tag:yaml.org,2002:null")
+
+    @property
+    def is_mapping(self) -> bool:
+        return isinstance(self.node, yaml.MappingNode)
+
+    @property
+    def is_sequence(self) -> bool:
+        return isinstance(self.node, yaml.SequenceNode)
+
+    def scalar(self):
+        """The Python value of a scalar node (SafeLoader's rules)."""
+        if self.node is None:
+            return None
+        return self.doc.loader.construct_object(self.node, deep=True)
+
+    def describe(self) -> str:
+        """How the value reads, for 'got ...' in messages."""
+        n = self.node
+        if self.is_null:
+            return "nothing (null)"
+        if isinstance(n, yaml.ScalarNode):
+            text = repr(self.scalar())
+        elif isinstance(n, yaml.SequenceNode):
+            text = _source(n) or f"a list of {len(n.value)} items"
+            if _source(n):
+                text = f"{text}"
+            else:
+                return text
+        else:
+            return "a mapping" if not _source(n) else f"a mapping {_source(n)}"
+        return text if len(text) <= 60 else text[:57] + "..."
+
+    # -- readers -------------------------------------------------------------------------------
+    def as_str(self, what: str = "a string") -> str:
+        v = self.scalar() if isinstance(self.node, yaml.ScalarNode) else None
+        if not isinstance(v, str) or self.is_null:
+            raise self.error(f"expected {what}, got {self.describe()}")
+        return v
+
+    def as_name(self, what: str = "a name") -> str:
+        v = self.as_str(what)
+        if not NAME_RE.match(v):
+            raise self.error(f"expected {what} made of letters, digits, '_' and '-' "
+                             f"(starting with a letter or digit), got {v!r}")
+        return v
+
+    def as_enum(self, choices: Sequence, what: str = "") -> object:
+        v = self.scalar() if isinstance(self.node, yaml.ScalarNode) else None
+        if isinstance(v, bool) or v not in choices or self.is_null:
+            label = f"{what} " if what else ""
+            raise self.error(f"expected {label}one of {quoted_list(choices)}, got "
+                             f"{self.describe()}{suggest(v, [str(c) for c in choices])}")
+        return v
+
+    def as_bool(self) -> bool:
+        v = self.scalar() if isinstance(self.node, yaml.ScalarNode) else None
+        if not isinstance(v, bool):
+            raise self.error(f"expected true or false, got {self.describe()}")
+        return v
+
+    def _number(self):
+        """int/float of a scalar, or None. Plain (unquoted) '1e-3' counts as a number although
+        YAML 1.1 reads it as a string."""
+        if not isinstance(self.node, yaml.ScalarNode) or self.is_null:
+            return None
+        v = self.scalar()
+        if isinstance(v, bool):
+            return None
+        if isinstance(v, (int, float)):
+            return v
+        if isinstance(v, str) and self.node.style is None and _NUMBER_RE.match(v):
+            return float(v.replace("_", ""))
+        return None
+
+    def as_float(self, unit: str = "", *, lo: float | None = None, hi: float | None = None,
+                 lo_open: bool = False, hi_open: bool = False) -> float:
+        v = self._number()
+        u = f" ({unit})" if unit else ""
+        if v is None:
+            raise self.error(f"expected a number{u}, got {self.describe()}")
+        v = float(v)
+        if not math.isfinite(v):
+            raise self.error(f"expected a finite number{u}, got {self.describe()}")
+        _check_range(self, v, lo, hi, lo_open, hi_open, u)
+        return v
+
+    def as_int(self, unit: str = "", *, lo: int | None = None, hi: int | None = None) -> int:
+        v = self._number()
+        u = f" ({unit})" if unit else ""
+        if v is None or isinstance(v, float) and not v.is_integer():
+            raise self.error(f"expected an integer{u}, got {self.describe()}")
+        v = int(v)
+        _check_range(self, v, lo, hi, False, False, u)
+        return v
+
+    def items(self, what: str = "a list") -> list["Node"]:
+        if not self.is_sequence:
+            raise self.error(f"expected {what}, got {self.describe()}")
+        return [self.child(n, i) for i, n in enumerate(self.node.value)]
+
+    def as_floats(self, n: int | Sequence[int] | None, unit: str = "", *,
+                  lo: float | None = None, lo_open: bool = False,
+                  hi: float | None = None) -> tuple[float, ...]:
+        """A list of numbers; ``n`` an exact count, allowed counts, or None for any (>= 1)."""
+        counts = (n,) if isinstance(n, int) else tuple(n) if n is not None else None
+        u = f" ({unit})" if unit else ""
+        if counts is None:
+            want = "a list of numbers"
+        elif len(counts) == 1:
+            want = f"{counts[0]} numbers"
+        else:
+            want = f"{', '.join(map(str, counts[:-1]))} or {counts[-1]} numbers"
+        vals = []
+        if self.is_sequence:
+            for item in self.items():
+                v = item._number()
+                if v is None or not math.isfinite(float(v)):
+                    vals = None
+                    break
+                vals.append(float(v))
+        if (not self.is_sequence or vals is None or (counts and len(vals) not in counts)
+                or (counts is None and not vals)):
+            got = self.describe()
+            if self.is_sequence and vals is not None:
+                got = f"{len(vals)} numbers {got}"
+            raise self.error(f"expected {want}{u}, got {got}")
+        for item, v in zip(self.items(), vals):
+            _check_range(item, v, lo, hi, lo_open, False, u)
+        return tuple(vals)
+
+    def as_vec3(self, unit: str = "metres") -> tuple[float, float, float]:
+        return self.as_floats(3, unit)  # type: ignore[return-value]
+
+    def as_color(self, unit: str = "linear RGB") -> tuple[float, float, float]:
+        """A non-negative number (grey) or 3 non-negative numbers."""
+        if self.is_sequence:
+            return self.as_floats(3, unit, lo=0.0)  # type: ignore[return-value]
+        if self._number() is None:
+            raise self.error(f"expected a number or 3 numbers ({unit}), got {self.describe()}")
+        v = self.as_float(unit, lo=0.0)
+        return (v, v, v)
+
+    def as_mapping(self, what: str = "a mapping") -> "Fields":
+        return Fields(self, what=what)
+
+    def as_path(self, suffixes: Sequence[str], what: str) -> tuple[Path, str]:
+        """An existing file, relative to the spec's directory: (absolute path, as written)."""
+        text = self.as_str(f"a file path ({what})")
+        p = Path(text).expanduser()
+        full = (p if p.is_absolute() else self.doc.base_dir / p).resolve()
+        if suffixes and full.suffix.lower() not in suffixes:
+            raise self.error(f"expected a {what} file ({', '.join(suffixes)}), got {text!r}")
+        if not full.is_file():
+            raise self.error(f"file not found: {text!r} (looked for {full})")
+        return full, text
+
+    def plain(self):
+        """The whole value as plain Python data (for pass-through parameters); rejects
+        non-string keys and non-finite floats."""
+        if self.is_mapping:
+            f = self.as_mapping()
+            return {k: f.get(k).plain() for k in f.keys()}
+        if self.is_sequence:
+            return [item.plain() for item in self.items()]
+        v = self.scalar()
+        if isinstance(v, float) and not math.isfinite(v):
+            raise self.error(f"expected a finite number, got {self.describe()}")
+        if not isinstance(v, (str, int, float, bool, type(None))):
+            raise self.error(f"expected a string, number, true/false or null, got {self.describe()}")
+        num = self._number()
+        return num if isinstance(v, str) and num is not None else v
+
+
+def _check_range(node: Node, v, lo, hi, lo_open, hi_open, u):
+    bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
+    bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
+    if bad_lo or bad_hi:
+        parts = []
+        if lo is not None:
+            parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+        if hi is not None:
+            parts.append(f"{'<' if hi_open else '<='} {hi:g}")
+        raise node.error(f"expected a value {' and '.join(parts)}{u}, got {v:g}")
+
+
+def _source(n: yaml.Node) -> str | None:
+    """The node's own text when it is short and on one line (flow style), else None."""
+    s, e = n.start_mark, n.end_mark
+    if s.buffer is None or s.line != e.line:
+        return None
+    text = s.buffer[s.index:e.index].strip()
+    return text if 0 < len(text) <= 60 else None
+
+
+class Fields:
+    """A YAML mapping with checked keys. Construction fails on a non-mapping, non-string or
+    duplicate keys; :meth:`check` fails on keys outside the allowed set."""
+
+    def __init__(self, owner: Node, what: str = "a mapping"):
+        if not owner.is_mapping:
+            raise owner.error(f"expected {what}, got {owner.describe()}")
+        self.owner = owner
+        loader = owner.doc.loader
+        loader.flatten_mapping(owner.node)  # YAML merge keys '<<'
+        self._keys: dict[str, tuple[Node, Node]] = {}
+        for k, v in owner.node.value:
+            knode = Node(owner.doc, k, owner.path)
+            key = knode.scalar() if isinstance(k, yaml.ScalarNode) else None
+            if not isinstance(key, str):
+                raise knode.error(f"expected a string key, got {knode.describe()}")
+            if key in self._keys:
+                first = self._keys[key][0].line
+                raise owner.child(k, key).error(f"duplicate key {key!r} (first given at line {first})")
+            self._keys[key] = (Node(owner.doc, k, owner.path), owner.child(v, key))
+
+    def check(self, required: Iterable[str] = (), optional: Iterable[str] = ()) -> "Fields":
+        required, optional = list(required), list(optional)
+        allowed = required + optional
+        for key, (knode, _) in self._keys.items():
+            if key not in allowed:
+                raise SpecError.at(
+                    self.owner.child(knode.node, key).where,
+                    f"unknown key {key!r}{suggest(key, allowed)}; allowed: {', '.join(allowed)}")
+        for key in required:
+            if key not in self._keys:
+                raise self.missing(key)
+        return self
+
+    def missing(self, key: str, hint: str = "") -> SpecError:
+        path = f"{self.owner.path}.{key}" if self.owner.path else key
+        return SpecError.at(Where(self.owner.doc.file, self.owner.line, path),
+                            f"missing required key {key!r}{hint}")
+
+    def keys(self) -> list[str]:
+        return list(self._keys)
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._keys and not self._keys[key][1].is_null
+
+    def get(self, key: str) -> Node | None:
+        """The value node, or None when absent (an explicit null counts as absent)."""
+        if key not in self:
+            return None
+        return self._keys[key][1]
+
+    def key_node(self, key: str) -> Node:
+        return self._keys[key][0]
+
+    def req(self, key: str) -> Node:
+        if key not in self:
+            raise self.missing(key)
+        return self._keys[key][1]
+
+    def one_of(self, keys: Sequence[str], *, required: bool = True) -> str | None:
+        """The single key of ``keys`` present; an error if several (or none and required)."""
+        present = [k for k in keys if k in self]
+        if len(present) > 1:
+            second = self._keys[present[1]][1]
+            raise second.error(f"give only one of {', '.join(keys)}; "
+                               f"found {' and '.join(present)}")
+        if not present:
+            if required:
+                path = self.owner.path or None
+                raise SpecError.at(Where(self.owner.doc.file, self.owner.line, path),
+                                   f"expected one of the keys {', '.join(keys)}")
+            return None
+        return present[0]
+
+    def float(self, key, default=None, unit="", **kw):
+        n = self.get(key)
+        return default if n is None else n.as_float(unit, **kw)
+
+    def int(self, key, default=None, unit="", **kw):
+        n = self.get(key)
+        return default if n is None else n.as_int(unit, **kw)
+
+    def vec3(self, key, default=None, unit="metres"):
+        n = self.get(key)
+        return default if n is None else n.as_vec3(unit)
