@@ -109,12 +109,13 @@ def opencv_from_colmap_pixels(uv):
     return np.asarray(uv, dtype=np.float64) - 0.5
 
 
-def opencv_pixel_from_film(sample, size):
-    """OpenCV pixel from Mitsuba's film sample position in [0, 1]^2 over the full image.
+def opencv_pixel_from_film(sample, size, offset=(0, 0)):
+    """OpenCV pixel from Mitsuba's film sample position in [0, 1]^2 over a crop window.
 
-    Works on numpy and Dr.Jit values alike (only arithmetic). ``size`` is (W, H).
+    ``size`` is the crop size (W, H) and ``offset`` its top-left pixel (both (0, 0) and the full
+    image without cropping). Works on numpy and Dr.Jit values alike (only arithmetic).
     """
-    return sample[0] * size[0] - 0.5, sample[1] * size[1] - 0.5
+    return sample[0] * size[0] + offset[0] - 0.5, sample[1] * size[1] + offset[1] - 0.5
 
 
 def film_from_opencv_pixel(uv, size):

@@ -388,8 +388,8 @@ class DatasetWriter:
         self._view_order: list[str] = []
 
         has_manifest = (self.root / MANIFEST_NAME).is_file()
-        if resume:
-            sio.remove_stale_temp_files(self.root) if self.root.is_dir() else None
+        if resume and self.root.is_dir():
+            sio.remove_stale_temp_files(self.root)
         if resume and has_manifest:
             m = _load_manifest(self.root)
             diffs = [f"{k}: dataset has {m[k]!r}, this run has {identity[k]!r}"
@@ -523,9 +523,8 @@ class DatasetWriter:
                 raise DatasetMismatchError(
                     f"view {view!r} is already complete in {self.root} with different files"
                     f" {changed}: outputs are not deterministic, or the dataset belongs to another run")
-        owners = {rel: v for v, e in self._views.items() if v != view for rel in e["files"]}
-        taken = [rel for rel in hashes if rel in owners or (rel in self._files and rel not in
-                 self._views.get(view, {}).get("files", []))]
+        own = set(self._views.get(view, {}).get("files", []))
+        taken = sorted(rel for rel in hashes if rel in self._files and rel not in own)
         if taken:
             raise ValueError(f"view {view!r}: files {taken} already belong to another view or the dataset")
 
@@ -693,6 +692,11 @@ def verify(out_dir) -> VerifyReport:
 
     missing, corrupted = [], []
     for rel, sha in m["files"].items():
+        try:
+            _check_rel_path(rel)
+        except ValueError as e:
+            problems.append(str(e))
+            continue
         p = root / rel
         if not p.is_file():
             missing.append(rel)

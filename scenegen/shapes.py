@@ -152,8 +152,9 @@ def sphere(radius: float = 1.0, subdivisions: int = 32) -> trimesh.Trimesh:
     th, ph = np.meshgrid(theta, phi, indexing="ij")  # (n+1, m+1)
     verts = r * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
     uv = np.stack([ph / (2 * np.pi), th / np.pi], -1)
-    # Pole rows: u at segment centres (their last column is unused).
-    uv[0, :, 0] = uv[-1, :, 0] = (np.arange(m + 1) + 0.5) / m
+    # Pole rows: u at segment centres (one column of each is unused and removed below).
+    uv[0, :, 0] = (np.arange(m + 1) + 0.5) / m  # north: cell j uses pole vertex j
+    uv[-1, :, 0] = (np.arange(m + 1) - 0.5) / m  # south: cell j uses pole vertex j + 1
     verts[0] = [0, 0, r]
     verts[-1] = [0, 0, -r]
     f = _grid_faces(n, m)  # (a,b,c), (a,c,d): theta x phi -> outward

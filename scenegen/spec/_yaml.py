@@ -111,10 +111,6 @@ class Node:
             text = repr(self.scalar())
         elif isinstance(n, yaml.SequenceNode):
             text = _source(n) or f"a list of {len(n.value)} items"
-            if _source(n):
-                text = f"{text}"
-            else:
-                return text
         else:
             return "a mapping" if not _source(n) else f"a mapping {_source(n)}"
         return text if len(text) <= 60 else text[:57] + "..."
@@ -297,18 +293,18 @@ class Fields:
             key = knode.scalar() if isinstance(k, yaml.ScalarNode) else None
             if not isinstance(key, str):
                 raise knode.error(f"expected a string key, got {knode.describe()}")
+            knode = owner.child(k, key)  # the key's own line, the value's field path
             if key in self._keys:
                 first = self._keys[key][0].line
-                raise owner.child(k, key).error(f"duplicate key {key!r} (first given at line {first})")
-            self._keys[key] = (Node(owner.doc, k, owner.path), owner.child(v, key))
+                raise knode.error(f"duplicate key {key!r} (first given at line {first})")
+            self._keys[key] = (knode, owner.child(v, key))
 
     def check(self, required: Iterable[str] = (), optional: Iterable[str] = ()) -> "Fields":
         required, optional = list(required), list(optional)
         allowed = required + optional
         for key, (knode, _) in self._keys.items():
             if key not in allowed:
-                raise SpecError.at(
-                    self.owner.child(knode.node, key).where,
+                raise knode.error(
                     f"unknown key {key!r}{suggest(key, allowed)}; allowed: {', '.join(allowed)}")
         for key in required:
             if key not in self._keys:
@@ -333,7 +329,12 @@ class Fields:
         return self._keys[key][1]
 
     def key_node(self, key: str) -> Node:
+        """The key itself (its line), with the value's field path."""
         return self._keys[key][0]
+
+    def value(self, key: str) -> Node:
+        """The value node of a present key, null or not."""
+        return self._keys[key][1]
 
     def req(self, key: str) -> Node:
         if key not in self:

@@ -1,0 +1,126 @@
+"""View sets -> camera poses.
+
+Each placement yields ``world_from_X`` poses, X being the camera or, for a rig view set, the rig
+frame; a rig's member cameras are then ``world_from_cam = world_from_rig @ rig_from_cam``.
+Placements look at their targets with :func:`scenegen.pose.look_at` (OpenCV axes, world up +z by
+default).
+
+Naming: every placement (one camera pose, or one rig pose shared by its members) gets the next
+``frame_index``, counted over all view sets in order from 0. A view is named
+``{prefix}_{frame_index:04d}`` for a lone camera and ``{prefix}_{member}_{frame_index:04d}`` for a
+rig member, where ``prefix`` is the view set's ``name`` or else its camera / rig name. Names are
+unique because frame indices are, and stable as long as the earlier view sets do not change.
+More than 10,000 frames widen the number so that names still sort in frame order.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from scenegen.errors import SpecError
+from scenegen.pose import Rigid3, look_at
+from scenegen.spec import model as m
+
+#: Random eyes closer than this to the target, or looking (nearly) along up, are redrawn.
+_MIN_SEPARATION_M = 1e-6
+_MIN_SIN_UP = 1e-3  # sine of the smallest accepted angle between view direction and up
+_MAX_REDRAWS = 1000
+
+
+def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
+    """All views of ``spec``, in order: view set by view set, placement by placement, and within
+    a rig placement member by member. Deterministic (random view sets use their seeds)."""
+    per_set = [_placement_poses(vs) for vs in spec.view_sets]  # world_from_X lists
+    n_frames = sum(len(p) for p in per_set)
+    width = max(4, len(str(max(n_frames - 1, 0))))
+    views: list[m.View] = []
+    frame = 0
+    for set_index, (vs, poses) in enumerate(zip(spec.view_sets, per_set)):
+        for world_from_x in poses:
+            if vs.camera is not None:
+                views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
+                                    cam_from_world=world_from_x.inverse(), frame_index=frame,
+                                    view_set=set_index))
+            else:
+                rig = spec.rigs[vs.rig]
+                for member in rig.members:
+                    world_from_cam = world_from_x @ member.rig_from_cam
+                    views.append(m.View(
+                        name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
+                        cam_from_world=world_from_cam.inverse(), rig=rig.name,
+                        rig_member=member.name, frame_index=frame, view_set=set_index))
+            frame += 1
+    return tuple(views)
+
+
+def _placement_poses(vs: m.ViewSet) -> list[Rigid3]:
+    p = vs.placement
+    try:
+        if isinstance(p, m.PoseList):
+            return list(p.world_from_cam)
+        if isinstance(p, m.LookAtList):
+            return [look_at(e.eye, e.target, e.up) for e in p.entries]
+        if isinstance(p, m.Orbit):
+            return [look_at(eye, p.center) for eye in orbit_eyes(p)]
+        if isinstance(p, m.LinePath):
+            return [look_at(eye, p.target, p.up) for eye in line_eyes(p)]
+        if isinstance(p, m.CirclePath):
+            return [look_at(eye, p.target, p.up) for eye in circle_eyes(p)]
+        if isinstance(p, m.RandomPoses):
+            return [look_at(e, t, p.up) for e, t in zip(*random_eyes_targets(p))]
+    except ValueError as e:  # eye == target, or looking along up
+        raise SpecError.at(vs.where, f"cannot place view set {vs.prefix!r}: {e}") from None
+    raise TypeError(f"unknown placement {type(p).__name__}")
+
+
+def orbit_eyes(p: m.Orbit) -> np.ndarray:
+    """(len(elevations) * count, 3) eyes, metres: elevation by elevation, azimuth from
+    start_azimuth_deg counter-clockwise about +z (from +x toward +y)."""
+    eyes = []
+    for el in np.radians(p.elevations_deg):
+        for k in range(p.count):
+            az = math.radians(p.start_azimuth_deg) + 2 * math.pi * k / p.count
+            eyes.append(np.asarray(p.center) + p.radius_m * np.array(
+                [math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)]))
+    return np.array(eyes).reshape(-1, 3)
+
+
+def line_eyes(p: m.LinePath) -> np.ndarray:
+    """(count, 3) eyes evenly spaced from start to end, both included (count 1: start)."""
+    s = np.linspace(0.0, 1.0, p.count) if p.count > 1 else np.zeros(1)
+    return np.asarray(p.start) + s[:, None] * (np.asarray(p.end) - np.asarray(p.start))
+
+
+def circle_eyes(p: m.CirclePath) -> np.ndarray:
+    """(count, 3) eyes on the circle, counter-clockwise about +z, the start not repeated."""
+    az = math.radians(p.start_azimuth_deg) + 2 * math.pi * np.arange(p.count) / p.count
+    return np.asarray(p.center) + np.stack(
+        [p.radius_m * np.cos(az), p.radius_m * np.sin(az), np.full(p.count, p.height_m)], axis=1)
+
+
+def random_eyes_targets(p: m.RandomPoses) -> tuple[np.ndarray, np.ndarray]:
+    """((count, 3) eyes, (count, 3) targets), uniform in their boxes, drawn with
+    ``numpy.random.default_rng(seed)`` in the order eye, target per view. Draws with the eye
+    within max(min_distance_m, 1e-6) of the target, or looking within 0.06 degrees of up, are
+    drawn again (at most 1000 times per view)."""
+    rng = np.random.default_rng(p.seed)
+    up = np.asarray(p.up, float)
+    up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0 else up
+    eyes, targets = [], []
+    for _ in range(p.count):
+        for _ in range(_MAX_REDRAWS):
+            eye = rng.uniform(p.eye_min, p.eye_max)
+            target = rng.uniform(p.target_min, p.target_max)
+            d = target - eye
+            dist = np.linalg.norm(d)
+            if dist >= max(p.min_distance_m, _MIN_SEPARATION_M) and \
+                    np.linalg.norm(np.cross(d / dist, up)) >= _MIN_SIN_UP:
+                break
+        else:
+            raise ValueError(f"no eye/target pair at least {p.min_distance_m:g} m apart and not "
+                             f"along up in {_MAX_REDRAWS} draws; check eye_box, target and "
+                             f"min_distance_m")
+        eyes.append(eye)
+        targets.append(target)
+    return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)
