@@ -1,0 +1,31 @@
+"""The YAML scene spec: parsing into frozen dataclasses, validation, view resolution.
+
+Layers: :mod:`.model` (dataclasses) <- :mod:`.load` (YAML + validation) and :mod:`.views`
+(view sets -> poses) <- :mod:`.serialize` (JSON-able form, hash). Nothing here imports Mitsuba.
+The format is documented in ``docs/scene_spec.md``.
+
+    >>> spec = load_spec("scenes/examples/orbit_objects.yaml")   # doctest: +SKIP
+    >>> views = resolve_views(spec)                               # doctest: +SKIP
+"""
+from scenegen.errors import SpecError, Where
+from scenegen.spec.load import TOP_LEVEL_KEYS, derive_seed, load_spec, parse_spec
+from scenegen.spec.model import (
+    AreaLight, ArucoGridTarget, Blob, Box, CameraSpec, CharucoTarget, CheckerboardTarget,
+    CirclePath, ConductorMaterial, ConstantLight, Cylinder, DiffuseMaterial, EnvmapLight, Light,
+    LinePath, LookAt, LookAtList, Material, Mesh, Orbit, Placement, Plane, PlasticMaterial,
+    PointLight, PoseList, RandomPoses, RenderSettings, Rig, RigMember, SceneObject, SceneSpec,
+    Shape, Sphere, SpotLight, Target, Texture, Torus, Transform, View, ViewSet,
+)
+from scenegen.spec.serialize import canonical_json, spec_sha256, spec_to_dict
+from scenegen.spec.views import resolve_views
+
+__all__ = [
+    "SpecError", "Where", "load_spec", "parse_spec", "resolve_views", "spec_to_dict",
+    "spec_sha256", "canonical_json", "derive_seed", "TOP_LEVEL_KEYS",
+    "AreaLight", "ArucoGridTarget", "Blob", "Box", "CameraSpec", "CharucoTarget",
+    "CheckerboardTarget", "CirclePath", "ConductorMaterial", "ConstantLight", "Cylinder",
+    "DiffuseMaterial", "EnvmapLight", "Light", "LinePath", "LookAt", "LookAtList", "Material",
+    "Mesh", "Orbit", "Placement", "Plane", "PlasticMaterial", "PointLight", "PoseList",
+    "RandomPoses", "RenderSettings", "Rig", "RigMember", "SceneObject", "SceneSpec", "Shape",
+    "Sphere", "SpotLight", "Target", "Texture", "Torus", "Transform", "View", "ViewSet",
+]
