@@ -166,9 +166,10 @@ class ViewCamera:
 def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None) -> dict:
     """Validate a truth dict (keys :data:`TRUTH_KEYS`) and return it with arrays as stored.
 
-    Float keys must be float32 (the stored type; cast explicitly rather than lose precision
-    silently), ``object_id``/``instance_id`` integers in [0, 2^32) (returned as uint32), ``valid``
-    bool. Shapes: (H, W), (H, W, 3) for points and normals, (H, W, 2) for uv; ``shape`` (H, W)
+    Float keys may be any float dtype; they are stored, and returned, as float32 (float64 input,
+    e.g. from the truth pass, is rounded to nearest: about 6e-8 relative, far below 1e-3 px of
+    reprojection error). ``object_id``/``instance_id``: integers in [0, 2^32) (returned as
+    uint32); ``valid``: bool. Shapes: (H, W), (H, W, 3) for points and normals, (H, W, 2) for uv; ``shape`` (H, W)
     if given. Misses (``~valid``) must carry depth_z = range = +inf, NaN points, normals and uv,
     and ids 0; hits finite depth_z, range, points and normals.
     """
@@ -187,10 +188,11 @@ def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None =
     for key, (_, comps) in _TRUTH_FLOAT_LAYOUT.items():
         a = np.asarray(truth[key])
         want = hw if comps is None else hw + (len(comps),)
-        if a.dtype != np.float32:
-            raise TypeError(f"truth {key!r} must be float32 (stored as EXR FLOAT), got {a.dtype}")
+        if not np.issubdtype(a.dtype, np.floating):
+            raise TypeError(f"truth {key!r} must be a float array (stored as float32), got {a.dtype}")
         if a.shape != want:
             raise ValueError(f"truth {key!r} must have shape {want}, got {a.shape}")
+        a = a.astype(np.float32, copy=False)
         if key in ("depth_z", "range"):
             if not np.all(a[miss] == np.inf):
                 raise ValueError(f"truth {key!r} must be +inf where valid is False")
@@ -228,15 +230,17 @@ def encode_view(view: str, *, image: np.ndarray, linear_rgb: np.ndarray,
     """Encode one view's files: ``{relative path: bytes}`` (pure; writes nothing).
 
     image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16 (the rendered, possibly corrupted image).
-    linear_rgb: (H, W, 3) float32, clean linear radiance.
+    linear_rgb: (H, W, 3) float, clean linear radiance (stored as float32).
     truth: see :func:`check_truth`.
     """
     paths = view_paths(view)
     image = np.asarray(image)
     hw = image.shape[:2]
     linear_rgb = np.asarray(linear_rgb)
-    if linear_rgb.dtype != np.float32 or linear_rgb.shape != hw + (3,):
-        raise ValueError(f"linear_rgb must be float32 {hw + (3,)}, got {linear_rgb.dtype} {linear_rgb.shape}")
+    if not np.issubdtype(linear_rgb.dtype, np.floating) or linear_rgb.shape != hw + (3,):
+        raise ValueError(f"linear_rgb must be a float {hw + (3,)} array, got {linear_rgb.dtype}"
+                         f" {linear_rgb.shape}")
+    linear_rgb = linear_rgb.astype(np.float32, copy=False)
     t = check_truth(truth, shape=hw)
     return {
         paths["image"]: sio.encode_png(image),

@@ -368,11 +368,15 @@ def load_mesh(path) -> trimesh.Trimesh:
     """Load a PLY, OBJ, GLB/GLTF or STL file as one ``trimesh.Trimesh``.
 
     A file holding a scene (several meshes, node transforms) is flattened: every mesh instance is
-    transformed into the file's root frame and concatenated. Vertices are kept as stored (no
-    merging or reordering). UVs are kept when every part has them, converted to the project's
-    convention (v = 0 at the top row); the material (e.g. its texture image) stays on
-    ``mesh.visual``. Raises ValueError naming the file when it is missing, of an unsupported type,
-    unreadable, or has no triangles.
+    transformed into the file's root frame (faces reversed under a mirroring transform, keeping
+    the winding outward) and concatenated, in the scene graph's order. Vertices are kept as stored
+    (no merging or reordering), as float64. UVs are kept when every instance has them, converted
+    to the project's convention (v = 0 at the top row); the file's material is kept on
+    ``mesh.visual.material`` only for a single-instance file. The flattening is done here, not by
+    trimesh's ``Scene.to_mesh``, which copies materials and needs Pillow for that.
+
+    Raises ValueError naming the file when it is missing, of an unsupported type, unreadable, or
+    has no triangles.
     """
     p = Path(path)
     ext = p.suffix.lower()
@@ -383,32 +387,34 @@ def load_mesh(path) -> trimesh.Trimesh:
         raise ValueError(f"mesh file {str(p)!r}: file not found")
     try:
         scene = trimesh.load_scene(str(p), process=False)
-        geoms = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
-        if not geoms or all(len(g.faces) == 0 for g in geoms):
-            raise ValueError("it contains no triangles")
-        mesh = scene.to_mesh() if len(scene.graph.nodes_geometry) != 1 or len(geoms) != 1 \
-            else _single(scene)
-    except ValueError as e:
-        raise ValueError(f"mesh file {str(p)!r}: {e}") from None
+        parts = []  # (vertices, faces, uv or None, material or None)
+        for node in scene.graph.nodes_geometry:
+            transform, name = scene.graph[node]
+            g = scene.geometry[name]
+            if not isinstance(g, trimesh.Trimesh) or len(g.faces) == 0:
+                continue
+            T = np.asarray(transform, dtype=np.float64)
+            v = np.asarray(g.vertices, dtype=np.float64) @ T[:3, :3].T + T[:3, 3]
+            f = np.asarray(g.faces, dtype=np.int64)
+            if np.linalg.det(T[:3, :3]) < 0:
+                f = f[:, ::-1]
+            vis = g.visual
+            uv = None
+            if isinstance(vis, trimesh.visual.TextureVisuals) and vis.uv is not None \
+                    and len(vis.uv) == len(v):
+                uv = uv_from_trimesh(vis.uv)
+            parts.append((v, f, uv, getattr(vis, "material", None)))
     except Exception as e:  # trimesh raises many types on corrupt files
         raise ValueError(f"mesh file {str(p)!r}: could not be read ({type(e).__name__}: {e})") \
             from None
-    if len(mesh.faces) == 0:
+    if not parts:
         raise ValueError(f"mesh file {str(p)!r}: it contains no triangles")
-    mesh = trimesh.Trimesh(vertices=np.asarray(mesh.vertices, dtype=np.float64),
-                           faces=np.asarray(mesh.faces, dtype=np.int64),
-                           visual=mesh.visual, process=False)
-    uv = getattr(mesh.visual, "uv", None)
-    if uv is not None and len(uv) == len(mesh.vertices):
-        mesh.visual.uv = uv_from_trimesh(uv)
-    return mesh
-
-
-def _single(scene: trimesh.Scene) -> trimesh.Trimesh:
-    """The one mesh of a one-node scene, with its node transform applied (no copy of visuals lost)."""
-    node = scene.graph.nodes_geometry[0]
-    transform, name = scene.graph[node]
-    mesh = scene.geometry[name].copy()
-    if not np.allclose(transform, np.eye(4)):
-        mesh.apply_transform(transform)
-    return mesh
+    offsets = np.cumsum([0] + [len(v) for v, *_ in parts])[:-1]
+    verts = np.concatenate([v for v, *_ in parts])
+    faces = np.concatenate([f + o for (_, f, *_), o in zip(parts, offsets)])
+    visual = None
+    if all(uv is not None for _, _, uv, _ in parts):
+        material = parts[0][3] if len(parts) == 1 else None
+        visual = trimesh.visual.TextureVisuals(
+            uv=np.concatenate([uv for _, _, uv, _ in parts]), material=material)
+    return trimesh.Trimesh(vertices=verts, faces=faces, visual=visual, process=False)

@@ -345,7 +345,7 @@ TEXTURE_KINDS: dict[str, Callable[..., np.ndarray]] = {
     "noise": noise,
     "speckle": speckle,
     "natural": natural,
-    "image": lambda path: load_image(path),
+    "image": load_image,
 }
 
 

@@ -277,10 +277,20 @@ class TestVerify:
 
 
 class TestValidation:
-    def test_truth_must_be_float32(self, tmp_path):
+    def test_float64_truth_stored_as_float32(self, tmp_path):
+        """The truth pass derives in float64; the format stores float32 (rounded to nearest)."""
         v = make_view(0)
-        v["truth"]["depth_z"] = v["truth"]["depth_z"].astype(np.float64)
-        with pytest.raises(TypeError, match="depth_z.*float32"):
+        p64 = v["truth"]["points_world"].astype(np.float64) + 1e-9  # not representable in float32
+        v["truth"]["points_world"] = p64
+        w = new_writer(tmp_path / "b")
+        w.write_view("a", **v)
+        back = ds.Dataset(tmp_path / "b").truth("a")["points_world"]
+        assert bits_equal(back, p64.astype(np.float32))
+
+    def test_truth_must_be_float(self, tmp_path):
+        v = make_view(0)
+        v["truth"]["depth_z"] = np.zeros((H, W), np.int32)
+        with pytest.raises(TypeError, match="depth_z.*float"):
             new_writer(tmp_path / "b").write_view("a", **v)
 
     @pytest.mark.parametrize("key,value,msg", [
@@ -327,3 +337,52 @@ class TestValidation:
         e = cams["views"]["cam0_001"]
         assert set(e) == {"camera", "cam_from_world", "camera_name", "rig", "rig_member", "frame_index"}
         assert Rigid3.from_dict(e["cam_from_world"]).allclose(view_cameras()["cam0_001"].cam_from_world, 0)
+
+
+_SLOW_WRITER = r"""
+import sys, time
+sys.path.insert(0, sys.argv[2])
+from scenegen import io as sio
+import test_dataset as t
+
+real = sio.atomic_write
+
+def slow(path, write_fn):
+    def halves(f):  # be killable between the two halves of every file
+        class Half:
+            def write(self, b):
+                f.write(b[: len(b) // 2]); f.flush(); time.sleep(0.01); f.write(b[len(b) // 2:])
+        write_fn(Half())
+    real(path, halves)
+
+sio.atomic_write = slow
+t.write_dataset(t.Path(sys.argv[1]))
+print("finished")
+"""
+
+
+def test_sigkill_and_resume_equals_uninterrupted(tmp_path, complete):
+    """A real SIGKILL in the middle of a run, then resume=True: the same bytes as a clean run."""
+    import time
+
+    out = tmp_path / "b"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(out), str(Path(__file__).parent)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            views = json.loads((out / "manifest.json").read_bytes())["views"]
+        except (FileNotFoundError, ValueError, KeyError):
+            views = {}
+        if sum(e["status"] == "complete" for e in views.values()) >= 2:
+            break
+        time.sleep(0.005)
+    time.sleep(0.013)  # land somewhere inside the next view's files
+    proc.kill()
+    stdout, stderr = proc.communicate()
+    assert b"finished" not in stdout, "the writer finished before it could be killed"
+    rep = ds.verify(out)
+    assert not rep.ok and rep.missing == rep.corrupted == () and rep.incomplete_views
+    write_dataset(out, writer=new_writer(out, resume=True))
+    assert all_bytes(out) == all_bytes(complete)
+    assert ds.verify(out).ok

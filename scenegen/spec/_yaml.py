@@ -37,6 +37,7 @@ class Document:
     def __init__(self, text: str, file: str, base_dir: Path):
         self.file = file
         self.base_dir = base_dir
+        self._pairs: dict[int, list] = {}
         self.loader = yaml.SafeLoader(text)
         try:
             try:
@@ -51,6 +52,20 @@ class Document:
         except yaml.YAMLError as e:
             raise SpecError(f"invalid YAML: {e}", file=file) from None
         self.root = Node(self, root, "")
+
+    def pairs(self, node: yaml.MappingNode) -> list[tuple[yaml.Node, yaml.Node, bool]]:
+        """(key, value, written_here) of a mapping after YAML merge keys ('<<') are applied;
+        merged pairs come first. Cached: flattening changes the node."""
+        if id(node) not in self._pairs:
+            own = {id(k) for k, _ in node.value}
+            try:
+                self.loader.flatten_mapping(node)
+            except yaml.MarkedYAMLError as e:
+                mark = e.problem_mark or e.context_mark
+                raise SpecError(f"invalid YAML merge: {e.problem}", file=self.file,
+                                line=mark.line + 1 if mark else None) from None
+            self._pairs[id(node)] = [(k, v, id(k) in own) for k, v in node.value]
+        return self._pairs[id(node)]
 
     def where(self, node: yaml.Node | None, path: str) -> Where:
         line = node.start_mark.line + 1 if node is not None else None
@@ -132,8 +147,10 @@ class Node:
     def as_enum(self, choices: Sequence, what: str = "") -> object:
         v = self.scalar() if isinstance(self.node, yaml.ScalarNode) else None
         if isinstance(v, bool) or v not in choices or self.is_null:
-            label = f"{what} " if what else ""
-            raise self.error(f"expected {label}one of {quoted_list(choices)}, got "
+            label = f" ({what})" if what else ""
+            listed = quoted_list(choices) if len(choices) <= 8 else (
+                f"{quoted_list(list(choices)[:5])}, ... ({len(choices)} values)")
+            raise self.error(f"expected one of {listed}{label}, got "
                              f"{self.describe()}{suggest(v, [str(c) for c in choices])}")
         return v
 
@@ -285,19 +302,20 @@ class Fields:
         if not owner.is_mapping:
             raise owner.error(f"expected {what}, got {owner.describe()}")
         self.owner = owner
-        loader = owner.doc.loader
-        loader.flatten_mapping(owner.node)  # YAML merge keys '<<'
         self._keys: dict[str, tuple[Node, Node]] = {}
-        for k, v in owner.node.value:
+        explicit: dict[str, int] = {}  # keys written in this mapping (not merged in) -> line
+        for k, v, own in owner.doc.pairs(owner.node):
             knode = Node(owner.doc, k, owner.path)
             key = knode.scalar() if isinstance(k, yaml.ScalarNode) else None
             if not isinstance(key, str):
                 raise knode.error(f"expected a string key, got {knode.describe()}")
             knode = owner.child(k, key)  # the key's own line, the value's field path
-            if key in self._keys:
-                first = self._keys[key][0].line
-                raise knode.error(f"duplicate key {key!r} (first given at line {first})")
-            self._keys[key] = (knode, owner.child(v, key))
+            if own:
+                if key in explicit:
+                    raise knode.error(f"duplicate key {key!r} (first given at line "
+                                      f"{explicit[key]})")
+                explicit[key] = knode.line
+            self._keys[key] = (knode, owner.child(v, key))  # explicit keys override merged ones
 
     def check(self, required: Iterable[str] = (), optional: Iterable[str] = ()) -> "Fields":
         required, optional = list(required), list(optional)

@@ -159,7 +159,8 @@ class _Parser:
                                       "use type: image for image files")
         params = {}
         if "params" in f:
-            f.get("params").as_mapping("a mapping of texture parameters")
+            pf = f.get("params").as_mapping("a mapping of texture parameters")
+            _check_texture_params(kind, pf)
             params = f.get("params").plain()
         seed = f.int("seed", None, lo=0, hi=_SEED_MAX)
         if seed is None:
@@ -243,7 +244,7 @@ class _Parser:
             kind = f.req("type").as_enum(m.SHAPE_KINDS, "shape type")
         keys = {
             "plane": ("size",), "box": ("size",), "sphere": ("radius",),
-            "cylinder": ("radius", "height", "capped"), "torus": ("major_radius", "minor_radius"),
+            "cylinder": ("radius", "height"), "torus": ("major_radius", "minor_radius"),
             "blob": ("radius", "amplitude", "frequency", "subdivisions", "seed"),
         }[kind]
         if f is None:
@@ -263,8 +264,7 @@ class _Parser:
         if kind == "sphere":
             return m.Sphere(radius=pos("radius", 0.5))
         if kind == "cylinder":
-            capped = f.get("capped").as_bool() if "capped" in f else True
-            return m.Cylinder(radius=pos("radius", 0.5), height=pos("height", 1.0), capped=capped)
+            return m.Cylinder(radius=pos("radius", 0.5), height=pos("height", 1.0))
         if kind == "torus":
             major, minor = pos("major_radius", 0.5), pos("minor_radius", 0.15)
             if minor >= major:
@@ -274,7 +274,7 @@ class _Parser:
             return m.Torus(major_radius=major, minor_radius=minor)
         seed = f.int("seed", None, lo=0, hi=_SEED_MAX)
         return m.Blob(radius=pos("radius", 0.5),
-                      amplitude=f.float("amplitude", 0.15, "fraction of radius", lo=0.0, hi=0.5,
+                      amplitude=f.float("amplitude", 0.15, "fraction of radius", lo=0.0, hi=1.0,
                                         hi_open=True),
                       frequency=f.float("frequency", 2.0, lo=0.0, lo_open=True),
                       subdivisions=f.int("subdivisions", 5, lo=1, hi=7),
@@ -461,12 +461,10 @@ class _Parser:
             for bad in ("fx", "fy"):
                 if bad in f:
                     raise f.get(bad).error(f"give either fov_deg or fx and fy, not both")
-            fov_hi = 360.0 if model == "fisheye" else 180.0
             fov = f.float("fov_deg", unit="horizontal field of view, degrees", lo=0.0,
-                          lo_open=True, hi=fov_hi, hi_open=True)
-            half = math.radians(fov) / 2
-            # Equidistant fisheye: r = f * theta at zero distortion; perspective: r = f tan(theta).
-            fx = fy = (W / 2) / (half if model == "fisheye" else math.tan(half))
+                          lo_open=True, hi=180.0, hi_open=True)
+            # As scenegen.camera.Camera.from_fov: the FoV of the undistorted pinhole.
+            fx = fy = (W / 2) / math.tan(math.radians(fov) / 2)
         else:
             if "fx" not in f:
                 raise f.missing("fx", " (or give fov_deg)")
@@ -591,8 +589,14 @@ class _Parser:
         for item in node.items("a list of {eye, target, up} mappings"):
             f = item.as_mapping("a mapping with eye, target and optionally up").check(
                 required=("eye", "target"), optional=("up",))
-            entries.append(m.LookAt(eye=f.vec3("eye"), target=f.vec3("target"),
-                                    up=f.vec3("up", (0.0, 0.0, 1.0), "direction")))
+            entry = m.LookAt(eye=f.vec3("eye"), target=f.vec3("target"),
+                             up=f.vec3("up", (0.0, 0.0, 1.0), "direction"))
+            try:
+                look_at(entry.eye, entry.target, entry.up)
+            except ValueError as e:
+                raise item.error(f"cannot look from {list(entry.eye)} at {list(entry.target)} "
+                                 f"with up {list(entry.up)}: {e}") from None
+            entries.append(entry)
         if not entries:
             raise node.error("expected at least one {eye, target} entry, got an empty list")
         return m.LookAtList(entries=tuple(entries))
@@ -691,6 +695,17 @@ def _freeze(value):
     if isinstance(value, list):
         return tuple(_freeze(v) for v in value)
     return value
+
+
+def _check_texture_params(kind: str, params: Fields):
+    """Parameter names against scenegen.textures (when present); values are its business."""
+    try:
+        from scenegen.textures import texture_params
+    except ModuleNotFoundError as e:
+        if e.name == "scenegen.textures":
+            return
+        raise
+    params.check(optional=texture_params(kind))
 
 
 def _check_with_camera_model(cam: m.CameraSpec, node: Node):

@@ -152,8 +152,7 @@ class Sphere:
 @dataclass(frozen=True, kw_only=True)
 class Cylinder:
     radius: float = 0.5  # metres
-    height: float = 1.0  # metres along object z, from -height/2 to +height/2
-    capped: bool = True  # closed by two disks
+    height: float = 1.0  # metres along object z, from -height/2 to +height/2 (closed by caps)
     kind: str = field(default="cylinder", init=False)
 
 
@@ -167,8 +166,8 @@ class Torus:
 @dataclass(frozen=True, kw_only=True)
 class Blob:
     radius: float = 0.5  # metres, radius of the undisplaced sphere
-    amplitude: float = 0.15  # radial displacement as a fraction of radius, in [0, 0.5)
-    frequency: float = 2.0  # bumps per radian-ish: noise frequency on the unit sphere (> 0)
+    amplitude: float = 0.15  # radial displacement as a fraction of radius, in [0, 1)
+    frequency: float = 2.0  # noise cycles per unit length on the unit sphere (> 0)
     subdivisions: int = 5  # icosphere subdivision level, 1..7 (20 * 4**n triangles)
     seed: int = 0  # noise seed (explicit, or derived from the scene seed and field path)
     kind: str = field(default="blob", init=False)
@@ -330,7 +329,8 @@ class CameraSpec:
     cy: float  # principal point v, pixels
     skew: float = 0.0  # K[0, 1], pixels
     dist: tuple[float, ...] = ()  # distortion coefficients (unitless), see above
-    fov_deg: float | None = None  # horizontal FoV as written (fx, fy derived from it), degrees
+    fov_deg: float | None = None  # horizontal FoV of the undistorted pinhole as written (fx, fy
+    # derived from it: fx = fy = (W/2) / tan(fov/2)), degrees
     where: Where | None = field(**_WHERE)
 
     @property

@@ -55,23 +55,30 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
 
 
 def _placement_poses(vs: m.ViewSet) -> list[Rigid3]:
+    """world_from_X for every placement of a view set (X = camera or rig frame)."""
     p = vs.placement
-    try:
-        if isinstance(p, m.PoseList):
-            return list(p.world_from_cam)
-        if isinstance(p, m.LookAtList):
-            return [look_at(e.eye, e.target, e.up) for e in p.entries]
-        if isinstance(p, m.Orbit):
-            return [look_at(eye, p.center) for eye in orbit_eyes(p)]
-        if isinstance(p, m.LinePath):
-            return [look_at(eye, p.target, p.up) for eye in line_eyes(p)]
-        if isinstance(p, m.CirclePath):
-            return [look_at(eye, p.target, p.up) for eye in circle_eyes(p)]
-        if isinstance(p, m.RandomPoses):
-            return [look_at(e, t, p.up) for e, t in zip(*random_eyes_targets(p))]
-    except ValueError as e:  # eye == target, or looking along up
-        raise SpecError.at(vs.where, f"cannot place view set {vs.prefix!r}: {e}") from None
-    raise TypeError(f"unknown placement {type(p).__name__}")
+    if isinstance(p, m.PoseList):
+        return list(p.world_from_cam)
+    if isinstance(p, m.LookAtList):
+        aims = [(e.eye, e.target, e.up) for e in p.entries]
+    elif isinstance(p, m.Orbit):
+        aims = [(eye, p.center, (0.0, 0.0, 1.0)) for eye in orbit_eyes(p)]
+    elif isinstance(p, (m.LinePath, m.CirclePath)):
+        eyes = line_eyes(p) if isinstance(p, m.LinePath) else circle_eyes(p)
+        aims = [(eye, p.target, p.up) for eye in eyes]
+    elif isinstance(p, m.RandomPoses):
+        aims = [(e, t, p.up) for e, t in zip(*random_eyes_targets(p, vs))]
+    else:
+        raise TypeError(f"unknown placement {type(p).__name__}")
+    poses = []
+    for k, (eye, target, up) in enumerate(aims):
+        try:
+            poses.append(look_at(eye, target, up))
+        except ValueError as e:  # eye == target, or looking along up
+            raise SpecError.at(vs.where, f"cannot place view {k} of view set {vs.prefix!r} "
+                               f"(eye {np.round(eye, 6).tolist()}, target "
+                               f"{np.round(target, 6).tolist()}): {e}") from None
+    return poses
 
 
 def orbit_eyes(p: m.Orbit) -> np.ndarray:
@@ -99,11 +106,12 @@ def circle_eyes(p: m.CirclePath) -> np.ndarray:
         [p.radius_m * np.cos(az), p.radius_m * np.sin(az), np.full(p.count, p.height_m)], axis=1)
 
 
-def random_eyes_targets(p: m.RandomPoses) -> tuple[np.ndarray, np.ndarray]:
+def random_eyes_targets(p: m.RandomPoses, vs: m.ViewSet | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
     """((count, 3) eyes, (count, 3) targets), uniform in their boxes, drawn with
     ``numpy.random.default_rng(seed)`` in the order eye, target per view. Draws with the eye
     within max(min_distance_m, 1e-6) of the target, or looking within 0.06 degrees of up, are
-    drawn again (at most 1000 times per view)."""
+    drawn again (at most 1000 times per view; then a SpecError at the view set)."""
     rng = np.random.default_rng(p.seed)
     up = np.asarray(p.up, float)
     up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0 else up
@@ -118,9 +126,10 @@ def random_eyes_targets(p: m.RandomPoses) -> tuple[np.ndarray, np.ndarray]:
                     np.linalg.norm(np.cross(d / dist, up)) >= _MIN_SIN_UP:
                 break
         else:
-            raise ValueError(f"no eye/target pair at least {p.min_distance_m:g} m apart and not "
-                             f"along up in {_MAX_REDRAWS} draws; check eye_box, target and "
-                             f"min_distance_m")
+            raise SpecError.at(vs.where if vs else None,
+                               f"no eye/target pair at least {p.min_distance_m:g} m apart and "
+                               f"not along up in {_MAX_REDRAWS} draws; check eye_box, target "
+                               f"and min_distance_m")
         eyes.append(eye)
         targets.append(target)
     return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)

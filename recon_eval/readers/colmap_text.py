@@ -1,0 +1,110 @@
+"""COLMAP text model: cameras.txt, images.txt, points3D.txt (colmap.github.io/format.html).
+
+images.txt stores ``cam_from_world`` as a (QW, QX, QY, QZ) quaternion and (TX, TY, TZ); each image
+takes two lines (header, then its 2D points, possibly empty). COLMAP pixel coordinates put the
+top-left pixel's centre at (0.5, 0.5); this reader converts principal points to OpenCV's (0, 0)
+convention (cx - 0.5, cy - 0.5) for the models it knows, and reports the raw parameters too.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from recon_eval.errors import InputError
+from recon_eval.poses import Poses
+from recon_eval.readers._quat import matrix_from_quat_wxyz
+
+#: COLMAP model -> index of (cx, cy) in its parameter list
+_PRINCIPAL_POINT = {
+    "SIMPLE_PINHOLE": (1, 2), "PINHOLE": (2, 3), "SIMPLE_RADIAL": (1, 2), "RADIAL": (1, 2),
+    "OPENCV": (2, 3), "OPENCV_FISHEYE": (2, 3), "FULL_OPENCV": (2, 3), "SIMPLE_RADIAL_FISHEYE": (1, 2),
+    "RADIAL_FISHEYE": (1, 2), "THIN_PRISM_FISHEYE": (2, 3), "FOV": (2, 3),
+}
+
+
+@dataclass(frozen=True)
+class ColmapCamera:
+    camera_id: int
+    model: str
+    width: int
+    height: int
+    params_colmap: tuple  # as in the file (COLMAP pixel convention)
+    params_opencv_px: tuple  # principal point shifted by -0.5 to OpenCV pixels
+
+
+@dataclass(frozen=True)
+class ColmapModel:
+    cameras: dict  # camera_id -> ColmapCamera
+    poses: Poses  # named by image NAME, cam_from_world
+    image_camera_ids: tuple  # camera id of each image, order of poses.names
+    points_world: np.ndarray  # (P, 3) metres (points3D.txt; empty if the file is absent)
+
+
+def _lines(path: Path) -> list[str]:
+    return [ln.rstrip("\n") for ln in path.read_text().splitlines() if not ln.lstrip().startswith("#")]
+
+
+def read_colmap_text(model_dir) -> ColmapModel:
+    d = Path(model_dir)
+    if not d.is_dir():
+        raise InputError(f"{d}: not a directory (expected a COLMAP text model with cameras.txt, images.txt)")
+    for name in ("cameras.txt", "images.txt"):
+        if not (d / name).is_file():
+            raise InputError(f"{d}: missing {name} (expected a COLMAP text model)")
+    cams = {}
+    for k, ln in enumerate(_lines(d / "cameras.txt")):
+        tok = ln.split()
+        if not tok:
+            continue
+        try:
+            cid, model, w, h = int(tok[0]), tok[1], int(tok[2]), int(tok[3])
+            params = tuple(float(v) for v in tok[4:])
+        except (ValueError, IndexError):
+            raise InputError(f"{d / 'cameras.txt'}: bad line {ln!r} (expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS...)") from None
+        cv = list(params)
+        if model in _PRINCIPAL_POINT and len(cv) > max(_PRINCIPAL_POINT[model]):
+            for i in _PRINCIPAL_POINT[model]:
+                cv[i] -= 0.5
+        cams[cid] = ColmapCamera(cid, model, w, h, params, tuple(cv))
+    names, qs, ts, cids = [], [], [], []
+    lines = _lines(d / "images.txt")
+    i = 0
+    while i < len(lines):
+        tok = lines[i].split()
+        if not tok:
+            i += 1
+            continue
+        if len(tok) < 10:
+            raise InputError(f"{d / 'images.txt'}: bad image line {lines[i]!r} (expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME)")
+        try:
+            q = [float(v) for v in tok[1:5]]
+            t = [float(v) for v in tok[5:8]]
+            cid = int(tok[8])
+        except ValueError:
+            raise InputError(f"{d / 'images.txt'}: bad image line {lines[i]!r}") from None
+        names.append(" ".join(tok[9:]))
+        qs.append(q)
+        ts.append(t)
+        cids.append(cid)
+        i += 2  # skip the POINTS2D line (possibly empty)
+    if names and not np.all(np.linalg.norm(np.asarray(qs), axis=1) > 0):
+        raise InputError(f"{d / 'images.txt'}: zero quaternion")
+    R = matrix_from_quat_wxyz(np.asarray(qs).reshape(-1, 4)) if names else np.zeros((0, 3, 3))
+    try:
+        poses = Poses(tuple(names), R, np.asarray(ts, dtype=np.float64).reshape(-1, 3))
+    except InputError as exc:
+        raise InputError(f"{d / 'images.txt'}: {exc}") from None
+    pts = np.zeros((0, 3))
+    if (d / "points3D.txt").is_file():
+        rows = []
+        for ln in _lines(d / "points3D.txt"):
+            tok = ln.split()
+            if tok:
+                try:
+                    rows.append([float(v) for v in tok[1:4]])
+                except ValueError:
+                    raise InputError(f"{d / 'points3D.txt'}: bad line {ln!r}") from None
+        pts = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
+    return ColmapModel(cams, poses, tuple(cids), pts)

@@ -1,0 +1,240 @@
+"""Adapter from the spec's frozen dataclasses to a loaded Mitsuba scene, one function per kind.
+
+Geometry is placed in the world in float64 numpy (object transforms applied to the vertices),
+so the dataset's world meshes and the rendered ones are the same triangles. Spheres are Mitsuba's
+analytic sphere (exact depth); every other shape is a triangle mesh from :mod:`scenegen.shapes`.
+Texture UVs: Mitsuba's bitmap puts v = 0 at the image's top row, the project's convention, so
+UVs pass through unchanged (checked in tests/test_render.py).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+import trimesh
+
+from scenegen import shapes, textures
+from scenegen.pose import Rigid3
+from scenegen.render import sensor as sensor_mod
+from scenegen.render.truth import shape_id_table
+from scenegen.spec import model as m
+
+#: Board pictures are black/white; printed paper is neither 0 nor 1 in reflectance.
+BOARD_BLACK, BOARD_WHITE = 0.03, 0.85
+
+
+@dataclass
+class BuiltScene:
+    """A loaded Mitsuba scene plus what the pipeline needs to render views of it."""
+
+    scene: object  # mi.Scene
+    sensors: dict  # camera name -> ScenegenSensor
+    cameras: dict  # camera name -> scenegen.camera.Camera
+    meshes_world: dict  # object name -> trimesh.Trimesh in the world frame (for export)
+    id_tables: tuple  # (object id table, instance id table) for the truth pass
+    boards: dict = field(default_factory=dict)  # object name -> (targets.Board, world_from_board)
+    objects: list = field(default_factory=list)  # [{name, object_id, instance_id, kind}] for cameras.json
+
+
+def _rgb(c) -> dict:
+    return {"type": "rgb", "value": [float(x) for x in c]}
+
+
+def _bitmap(img: np.ndarray) -> dict:
+    """Linear float32 (H, W, 3) reflectance as a raw (non-sRGB) Mitsuba bitmap texture."""
+    return {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)),
+            "raw": True, "filter_type": "bilinear", "wrap_mode": "clamp"}
+
+
+def texture_image(tex: m.Texture) -> np.ndarray:
+    if tex.kind == "image":
+        return textures.load_image(tex.path)
+    return textures.make_texture(tex.kind, dict(tex.params), tex.seed)
+
+
+def _reflectance(color, texture: m.Texture | None) -> dict:
+    return _bitmap(texture_image(texture)) if texture is not None else _rgb(color)
+
+
+def material_dict(mat) -> dict:
+    """Mitsuba BSDF for a spec material."""
+    if isinstance(mat, m.DiffuseMaterial):
+        return {"type": "diffuse", "reflectance": _reflectance(mat.color, mat.texture)}
+    if isinstance(mat, m.PlasticMaterial):
+        refl = _reflectance(mat.color, mat.texture)
+        if mat.roughness > 0:
+            return {"type": "roughplastic", "diffuse_reflectance": refl, "alpha": float(mat.roughness),
+                    "int_ior": float(mat.ior), "distribution": "ggx"}
+        return {"type": "plastic", "diffuse_reflectance": refl, "int_ior": float(mat.ior)}
+    if isinstance(mat, m.ConductorMaterial):
+        if mat.roughness > 0:
+            return {"type": "roughconductor", "material": mat.material, "alpha": float(mat.roughness),
+                    "distribution": "ggx"}
+        return {"type": "conductor", "material": mat.material}
+    raise TypeError(f"unknown material {type(mat).__name__}")
+
+
+def board_material(board) -> dict:
+    img = board.image.astype(np.float32) / 255.0
+    refl = BOARD_BLACK + (BOARD_WHITE - BOARD_BLACK) * img
+    return {"type": "diffuse", "reflectance": _bitmap(np.repeat(refl[..., None], 3, axis=2))}
+
+
+def geometry_mesh(geom, spec_seed: int = 0):
+    """(trimesh in the object frame, board or None) for a spec geometry (not spheres)."""
+    if isinstance(geom, m.Plane):
+        return shapes.plane(geom.size), None
+    if isinstance(geom, m.Box):
+        return shapes.box(geom.size), None
+    if isinstance(geom, m.Sphere):
+        return shapes.sphere(geom.radius), None
+    if isinstance(geom, m.Cylinder):
+        return shapes.cylinder(geom.radius, geom.height, capped=geom.capped) if _accepts(shapes.cylinder, "capped") \
+            else shapes.cylinder(geom.radius, geom.height), None
+    if isinstance(geom, m.Torus):
+        return shapes.torus(geom.major_radius, geom.minor_radius), None
+    if isinstance(geom, m.Blob):
+        return shapes.blob(geom.radius, geom.amplitude, geom.frequency, geom.seed, geom.subdivisions), None
+    if isinstance(geom, m.Mesh):
+        return shapes.load_mesh(geom.path), None
+    from scenegen import targets
+
+    board = targets.board_from_spec(geom)
+    return board.mesh(), board
+
+
+def _accepts(fn, name: str) -> bool:
+    import inspect
+
+    return name in inspect.signature(fn).parameters
+
+
+def _place(mesh: trimesh.Trimesh, tf: m.Transform) -> trimesh.Trimesh:
+    """Object -> world in float64: scale, then rotate and translate (normals follow)."""
+    v = np.asarray(mesh.vertices, dtype=np.float64) * np.asarray(tf.scale, dtype=np.float64)
+    v = tf.world_from_object.apply(v)
+    faces = np.asarray(mesh.faces)
+    if np.prod(tf.scale) < 0:  # a mirroring scale flips the winding
+        faces = faces[:, ::-1]
+    out = trimesh.Trimesh(vertices=v, faces=faces, process=False)
+    uv = getattr(mesh.visual, "uv", None)
+    if uv is not None:
+        out.visual = trimesh.visual.TextureVisuals(uv=np.asarray(uv, dtype=np.float64))
+    return out
+
+
+def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool):
+    """A Mitsuba mesh from world-frame triangles (float32 on upload), with UVs when present."""
+    uv = getattr(mesh.visual, "uv", None)
+    props = mi.Properties()
+    props["bsdf"] = mi.load_dict(bsdf)
+    mm = mi.Mesh(name, len(mesh.vertices), len(mesh.faces), props=props,
+                 has_vertex_normals=smooth, has_vertex_texcoords=uv is not None)
+    params = mi.traverse(mm)
+    params["vertex_positions"] = mi.Float(np.asarray(mesh.vertices, np.float32).ravel())
+    params["faces"] = mi.UInt32(np.asarray(mesh.faces, np.uint32).ravel())
+    if smooth:
+        params["vertex_normals"] = mi.Float(np.asarray(mesh.vertex_normals, np.float32).ravel())
+    if uv is not None:
+        params["vertex_texcoords"] = mi.Float(np.asarray(uv, np.float32).ravel())
+    params.update()
+    return mm
+
+
+# shapes whose shading normals are interpolated (curved surfaces approximated by triangles)
+_SMOOTH = (m.Cylinder, m.Torus, m.Blob, m.Sphere)
+
+
+def object_entry(obj: m.SceneObject, built: BuiltScene) -> dict:
+    """The Mitsuba dict entry for one object; records its world mesh, board and ids."""
+    geom = obj.geometry
+    bsdf = material_dict(obj.material)
+    if isinstance(geom, m.Sphere):
+        s = np.asarray(obj.transform.scale)
+        if not np.allclose(s, s[0]):
+            raise ValueError(f"object {obj.name!r}: a sphere takes a uniform scale, got {tuple(s)}")
+        radius = geom.radius * float(s[0])
+        center = obj.transform.world_from_object.t
+        # the analytic sphere renders and is intersected exactly; the mesh is only exported
+        built.meshes_world[obj.name] = _place(shapes.sphere(geom.radius), obj.transform)
+        R = obj.transform.world_from_object.R  # keeps the texture's orientation
+        T = np.eye(4)
+        T[:3, :3] = R * radius
+        T[:3, 3] = center
+        return {"type": "sphere", "to_world": mi.ScalarTransform4f(T), "bsdf": bsdf}
+    local, board = geometry_mesh(geom)
+    world = _place(local, obj.transform)
+    built.meshes_world[obj.name] = world
+    if board is not None:
+        if not np.allclose(obj.transform.scale, 1.0):
+            raise ValueError(f"object {obj.name!r}: calibration targets cannot be scaled (their size is exact)")
+        built.boards[obj.name] = (board, obj.transform.world_from_object)
+        bsdf = board_material(board)
+    smooth = isinstance(geom, _SMOOTH) or (isinstance(geom, m.Mesh) and len(world.faces) > 0 and
+                                           not _is_faceted(local))
+    return mitsuba_mesh(obj.name, world, bsdf, smooth)
+
+
+def _is_faceted(mesh: trimesh.Trimesh) -> bool:
+    """A loaded mesh with per-face vertices (no shared vertices) is flat-shaded."""
+    return len(mesh.vertices) >= 3 * len(mesh.faces)
+
+
+def light_entry(light, world_up=(0.0, 0.0, 1.0)) -> dict:
+    if isinstance(light, m.AreaLight):
+        T = light.world_from_light.matrix @ np.diag([light.size[0] / 2, light.size[1] / 2, 1.0, 1.0])
+        return {"type": "rectangle", "to_world": mi.ScalarTransform4f(T),
+                "emitter": {"type": "area", "radiance": _rgb(light.radiance)},
+                "bsdf": {"type": "diffuse", "reflectance": _rgb((0.0, 0.0, 0.0))}}
+    if isinstance(light, m.PointLight):
+        return {"type": "point", "position": [float(x) for x in light.position], "intensity": _rgb(light.intensity)}
+    if isinstance(light, m.SpotLight):
+        # Mitsuba's spot shines along its local +z: the light frame's +z points at the target
+        return {"type": "spot", "to_world": mi.ScalarTransform4f(light.world_from_light.matrix),
+                "intensity": _rgb(light.intensity), "cutoff_angle": float(light.cutoff_deg),
+                "beam_width": float(light.beam_width_deg)}
+    if isinstance(light, m.ConstantLight):
+        return {"type": "constant", "radiance": _rgb(light.radiance)}
+    if isinstance(light, m.EnvmapLight):
+        # Mitsuba's envmap has +y up; ours is +z: rotate +y onto +z, then turn about +z.
+        T = mi.ScalarTransform4f().rotate([0, 0, 1], light.rotation_z_deg) @ mi.ScalarTransform4f().rotate([1, 0, 0], 90)
+        return {"type": "envmap", "filename": str(light.path), "scale": float(light.scale), "to_world": T}
+    raise TypeError(f"unknown light {type(light).__name__}")
+
+
+def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) -> BuiltScene:
+    """Load ``spec`` into Mitsuba (current variant) with one of our sensors per spec camera."""
+    sensor_mod.register()
+    built = BuiltScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=())
+    d: dict = {"type": "scene", "integrator": {"type": "path", "max_depth": int(max_depth)}}
+    object_ids, instance_ids = {}, {}
+    for obj in spec.objects:
+        key = f"obj_{obj.object_id:04d}"
+        d[key] = object_entry(obj, built)
+        object_ids[key] = obj.object_id
+        instance_ids[key] = obj.instance_id
+        built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
+                              "kind": type(obj.geometry).__name__.lower()})
+    for i, light in enumerate(spec.lights):
+        d[f"light_{i:04d}"] = light_entry(light)
+    for name, cam_spec in spec.cameras.items():
+        cam = cam_spec.to_camera()
+        built.cameras[name] = cam
+        d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler)
+    built.scene = mi.load_dict(d)
+    by_id = {s.id(): s for s in built.scene.sensors()}
+    for name, cam in built.cameras.items():
+        built.sensors[name] = by_id[f"sensor_{name}"]
+    built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
+    return built
+
+
+def render_view(built: BuiltScene, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int) -> np.ndarray:
+    """Linear float32 (H, W, 3) radiance of one view."""
+    sensor = built.sensors[camera_name]
+    sensor.set_camera(built.cameras[camera_name], cam_from_world)
+    img = mi.render(built.scene, sensor=sensor, spp=int(spp), seed=int(seed))
+    return np.array(img, dtype=np.float32)[..., :3]

@@ -1,0 +1,32 @@
+"""Shared fixtures-as-functions for the recon_eval tests (seeded, small)."""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def random_rotation(rng: np.random.Generator) -> np.ndarray:
+    return Rotation.random(random_state=rng.integers(1 << 31)).as_matrix()
+
+
+def look_at_cam_from_world(center, target=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0)):
+    """cam_from_world (R, t) of an OpenCV camera at ``center`` looking at ``target``."""
+    c = np.asarray(center, float)
+    z = np.asarray(target, float) - c
+    z /= np.linalg.norm(z)
+    x = np.cross(z, up)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    R = np.stack([x, y, z])  # rows: camera axes in world
+    return R, -R @ c
+
+
+def ring_of_cameras(n: int = 8, radius: float = 3.0, height: float = 1.0):
+    """n cameras on a circle looking at the origin: (R (n,3,3), t (n,3)), cam_from_world."""
+    Rs, ts = [], []
+    for k in range(n):
+        a = 2 * np.pi * k / n
+        R, t = look_at_cam_from_world([radius * np.cos(a), radius * np.sin(a), height + 0.1 * k])
+        Rs.append(R)
+        ts.append(t)
+    return np.array(Rs), np.array(ts)
