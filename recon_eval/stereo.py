@@ -116,7 +116,7 @@ def kitti_d1(
         ei = kitti_interpolate_background(e)
         for name, g in (("noc", g_noc), ("occ", g_occ)):
             valid = np.isfinite(g) & (g > 0)
-            with np.errstate(invalid="ignore"):
+            with np.errstate(invalid="ignore", divide="ignore"):
                 err = np.abs(ei - g)
                 out = (err > abs_thresh_px) & (err / np.abs(g) > rel_thresh)
             out |= ~np.isfinite(ei)  # nothing to interpolate from: every pixel is an outlier

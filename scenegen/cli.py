@@ -120,6 +120,8 @@ def main(argv=None) -> int:
         return _err(str(e))
     except (DatasetError, BackendError, ValueError, FileNotFoundError) as e:
         return _err(str(e))
+    except BrokenPipeError:  # output piped into e.g. `head`
+        return 0
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

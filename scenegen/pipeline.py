@@ -109,7 +109,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     view_cams = {v.name: ds.ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
                                        frame_index=v.frame_index)
-                 for v in views if wanted is None or v.frame_index in wanted}
+                 for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
     resolved["objects_ids"] = built.objects
@@ -119,7 +119,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     for name, (board, world_from_board) in built.boards.items():
         writer.write_file(f"scene/targets/{name}.json", sio.encode_json(board_truth(board, world_from_board)))
 
-    todo = [(i, v) for i, v in enumerate(views) if v.name in view_cams]
+    todo = [(i, v) for i, v in enumerate(views) if wanted is None or v.frame_index in wanted]
     skipped = sum(writer.is_complete(v.name) for _, v in todo)
     rendered = 0
     with _progress(progress, len(todo)) as bar:

@@ -208,7 +208,12 @@ def torus(major_radius: float = 1.0, minor_radius: float = 0.25, sections: int =
     (z = +minor_radius, v = 0), then the outer equator (v = 0.25), bottom, inner equator, so the
     texture is upright seen from outside the outer equator with +z up. Seams duplicated.
     Vertices lie exactly on the torus; the polyhedron's volume is
-    2 pi^2 R r^2 * sinc(2 pi / sections) * sinc(2 pi / minor_sections), sinc(x) = sin(x) / x.
+    2 pi^2 R r^2 * sinc(2 pi / sections) * sinc(2 pi / minor_sections), sinc(x) = sin(x) / x:
+    each of the n = ``sections`` segments is the regular-polygon cross-section P (area
+    pi r^2 sinc(2 pi / minor_sections), centroid at distance R) swept between the planes at
+    phi_i and phi_i + 2 pi / n, its side quads being planar isosceles trapezoids; in the segment's
+    mid-plane frame it is {(x, y, z): (x / c, z) in P, |y| <= x tan(pi / n)} with c = cos(pi / n),
+    whose volume is 2 tan(pi / n) c^2 R A(P) = sin(2 pi / n) R A(P).
     """
     R = _positive("major_radius", major_radius)
     r = _positive("minor_radius", minor_radius)

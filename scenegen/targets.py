@@ -41,6 +41,8 @@ import cv2
 import numpy as np
 import trimesh
 
+from scenegen.pose import Rigid3
+
 BoardKind = str  # 'checkerboard' | 'charuco' | 'aruco'
 BOARD_KINDS = ("checkerboard", "charuco", "aruco")
 
@@ -153,6 +155,17 @@ class Board:
         return trimesh.Trimesh(vertices=v, faces=f, process=False,
                                visual=trimesh.visual.TextureVisuals(uv=uv))
 
+    def object_from_board(self) -> Rigid3:
+        """The board frame inside the spec's target object frame (board centred on the origin, in
+        z = 0, print facing +z, picture upright seen from +z with +y up, as :func:`shapes.plane`).
+
+        A 180 degree rotation about x (x -> x, y -> -y, z -> -z) plus a shift by half the board:
+        the top-left corner (0, 0, 0) goes to (-width/2, +height/2, 0) and the print normal -z
+        to +z. So ``world_from_board = world_from_object @ object_from_board``.
+        """
+        return Rigid3(np.diag([1.0, -1.0, -1.0]),
+                      np.array([-self.width_m / 2, self.height_m / 2, 0.0]))
+
     def cv2_board(self):
         """The equivalent OpenCV board object (CharucoBoard / GridBoard), for detection.
 
@@ -164,7 +177,8 @@ class Board:
                                           _dictionary(self.dictionary))
         if self.kind == "aruco":
             return cv2.aruco.GridBoard(self.grid, self.marker_m, self.separation_m,
-                                       _dictionary(self.dictionary))
+                                       _dictionary(self.dictionary),
+                                       np.asarray(self.marker_ids, dtype=np.int32))
         raise ValueError("a checkerboard has no cv2.aruco board object")
 
     def describe(self) -> dict:
@@ -208,6 +222,17 @@ def _count(name: str, value, minimum: int) -> int:
     return int(value)
 
 
+def _margin_px(margin_squares, margin_m, square_m: float, px_per_square: int) -> int:
+    if margin_m is not None:
+        if not margin_m >= 0:
+            raise ValueError(f"margin_m must be >= 0, got {margin_m!r}")
+        return _whole_px("margin (margin_m / square_m * px_per_square)",
+                         margin_m / square_m * px_per_square)
+    if not margin_squares >= 0:
+        raise ValueError(f"margin_squares must be >= 0, got {margin_squares!r}")
+    return _whole_px("margin (margin_squares * px_per_square)", margin_squares * px_per_square)
+
+
 def _inner_corners(cols: int, rows: int, square_m: float, offset_m: float) -> np.ndarray:
     """(cols * rows, 3): inner corner (col, row) at ((1 + col) s + o, (1 + row) s + o, 0),
     row-major from the top-left, x fastest."""
@@ -231,21 +256,21 @@ def _check_against_cv2(ours: np.ndarray, cv2_points, offset_m: float, what: str)
 
 
 def checkerboard_board(inner_cols: int, inner_rows: int, square_m: float,
-                       margin_squares: float = 1.0, px_per_square: int = 64) -> Board:
+                       margin_squares: float = 1.0, px_per_square: int = 64,
+                       margin_m: float | None = None) -> Board:
     """A plain checkerboard with ``inner_cols`` x ``inner_rows`` inner corners.
 
     (inner_cols + 1) x (inner_rows + 1) squares, the top-left one black, surrounded by a white
     margin of ``margin_squares`` squares (findChessboardCorners needs about one). Truth: the inner
     corners, ids and order as cv2.findChessboardCorners(image, (inner_cols, inner_rows)) returns
-    them on an upright view (row-major from the top-left).
+    them on an upright view (row-major from the top-left). ``margin_m``, when given, sets the
+    margin in metres instead of ``margin_squares``; it must come out as whole pixels.
     """
     cols = _count("inner_cols", inner_cols, 2)
     rows = _count("inner_rows", inner_rows, 2)
     s = _positive("square_m", square_m)
     pps = _count("px_per_square", px_per_square, 2)
-    if not margin_squares >= 0:
-        raise ValueError(f"margin_squares must be >= 0, got {margin_squares!r}")
-    margin_px = _whole_px("margin (margin_squares * px_per_square)", margin_squares * pps)
+    margin_px = _margin_px(margin_squares, margin_m, s, pps)
     nx, ny = cols + 1, rows + 1
     W, H = nx * pps + 2 * margin_px, ny * pps + 2 * margin_px
     img = np.full((H, W), 255, np.uint8)
@@ -263,12 +288,13 @@ def checkerboard_board(inner_cols: int, inner_rows: int, square_m: float,
 
 def charuco_board(squares_x: int, squares_y: int, square_m: float, marker_m: float,
                   dictionary: str = "DICT_5X5_100", margin_squares: float = 0.5,
-                  px_per_square: int = 100) -> Board:
+                  px_per_square: int = 100, margin_m: float | None = None) -> Board:
     """A ChArUco board drawn by ``cv2.aruco.CharucoBoard.generateImage``.
 
     ``squares_x`` x ``squares_y`` squares of side ``square_m`` with markers of side ``marker_m``
     in the white squares (OpenCV's current, non-legacy layout), a white margin of
-    ``margin_squares`` squares. The margin and the marker side must come out as whole pixels.
+    ``margin_squares`` squares (or ``margin_m`` metres when given). The margin and the marker
+    side must come out as whole pixels.
     Truth: the (squares_x - 1) * (squares_y - 1) ChArUco corners with OpenCV's ids, and the
     marker corners and ids.
     """
@@ -279,9 +305,7 @@ def charuco_board(squares_x: int, squares_y: int, square_m: float, marker_m: flo
     if m >= s:
         raise ValueError(f"marker_m ({m}) must be smaller than square_m ({s})")
     pps = _count("px_per_square", px_per_square, 2)
-    if not margin_squares >= 0:
-        raise ValueError(f"margin_squares must be >= 0, got {margin_squares!r}")
-    margin_px = _whole_px("margin (margin_squares * px_per_square)", margin_squares * pps)
+    margin_px = _margin_px(margin_squares, margin_m, s, pps)
     _whole_px("marker side (marker_m / square_m * px_per_square)", m / s * pps)
     d = _dictionary(dictionary)
     board = cv2.aruco.CharucoBoard((sx, sy), s, m, d)
@@ -317,13 +341,13 @@ def _exact_markers_in_squares(cv_markers: np.ndarray, s: float, m: float, margin
 
 def aruco_grid(markers_x: int, markers_y: int, marker_m: float, separation_m: float,
                dictionary: str = "DICT_5X5_100", margin_m: float | None = None,
-               px_per_marker: int = 100) -> Board:
+               px_per_marker: int = 100, first_id: int = 0) -> Board:
     """An ArUco grid drawn by ``cv2.aruco.GridBoard.generateImage``.
 
     ``markers_x`` x ``markers_y`` markers of side ``marker_m`` with gaps ``separation_m``, and a
     white margin ``margin_m`` (default: separation_m). Separation and margin must come out as
-    whole pixels at ``px_per_marker``. Truth points: every marker corner, id = marker_id * 4 +
-    corner (OpenCV corner order TL, TR, BR, BL).
+    whole pixels at ``px_per_marker``. Marker ids run row by row from ``first_id``. Truth
+    points: every marker corner, id = marker_id * 4 + corner (OpenCV corner order TL, TR, BR, BL).
     """
     mx = _count("markers_x", markers_x, 1)
     my = _count("markers_y", markers_y, 1)
@@ -336,10 +360,13 @@ def aruco_grid(markers_x: int, markers_y: int, marker_m: float, separation_m: fl
     ppm = ppx / m
     sep_px = _whole_px("separation (separation_m * px_per_marker / marker_m)", sep * ppm)
     margin_px = _whole_px("margin (margin_m * px_per_marker / marker_m)", margin * ppm)
+    first = _count("first_id", first_id, 0)
     d = _dictionary(dictionary)
-    if mx * my > len(d.bytesList):
-        raise ValueError(f"{dictionary} has {len(d.bytesList)} markers; the grid needs {mx * my}")
-    board = cv2.aruco.GridBoard((mx, my), m, sep, d)
+    if first + mx * my > len(d.bytesList):
+        raise ValueError(f"{dictionary} has {len(d.bytesList)} markers; the grid needs ids "
+                         f"{first}..{first + mx * my - 1}")
+    board = cv2.aruco.GridBoard((mx, my), m, sep, d,
+                                np.arange(first, first + mx * my, dtype=np.int32))
     W = mx * ppx + (mx - 1) * sep_px + 2 * margin_px
     H = my * ppx + (my - 1) * sep_px + 2 * margin_px
     img = board.generateImage((W, H), marginSize=margin_px, borderBits=1)
@@ -356,3 +383,49 @@ def aruco_grid(markers_x: int, markers_y: int, marker_m: float, separation_m: fl
                  point_ids=(ids[:, None] * 4 + np.arange(4)[None]).ravel(),
                  marker_corners_board=markers, marker_ids=ids, dictionary=str(dictionary),
                  grid=(mx, my), marker_m=m, separation_m=sep, margin_m=margin_m_exact)
+
+
+# --- from the scene spec ----------------------------------------------------------------------
+
+#: Candidate picture resolutions (pixels per square / per marker) tried by :func:`board_from_spec`,
+#: best first: the first one that puts every length on whole pixels is used.
+_SPEC_PX_CANDIDATES = tuple(range(100, 401)) + tuple(range(99, 31, -1))
+
+
+def board_from_spec(target) -> Board:
+    """Build the Board for a spec target (``scenegen.spec.model`` Checkerboard/Charuco/
+    ArucoGridTarget, read by attribute so this module does not import the spec layer).
+
+    The picture resolution is chosen here: the first pixels-per-square (or per-marker) in
+    100..400, then 99..32, at which the margin, markers and separations are whole pixels; a
+    ValueError names the target when there is none. The Board is in the BOARD frame (module
+    docstring); the spec's object frame (centred, facing +z) is ``board.object_from_board()``.
+    """
+    kind = getattr(target, "kind", None)
+    if kind == "checkerboard":
+        def build(px):
+            return checkerboard_board(target.inner_cols, target.inner_rows, target.square_m,
+                                      px_per_square=px, margin_m=target.margin_m)
+    elif kind == "charuco":
+        def build(px):
+            return charuco_board(target.squares_x, target.squares_y, target.square_m,
+                                 target.marker_m, dictionary=target.dictionary,
+                                 px_per_square=px, margin_m=target.margin_m)
+    elif kind in ("aruco_grid", "aruco"):
+        def build(px):
+            return aruco_grid(target.markers_x, target.markers_y, target.marker_m,
+                              target.separation_m, dictionary=target.dictionary,
+                              margin_m=target.margin_m, px_per_marker=px,
+                              first_id=getattr(target, "first_id", 0))
+    else:
+        raise ValueError(f"unknown calibration target kind {kind!r}")
+    last = None
+    for px in _SPEC_PX_CANDIDATES:
+        try:
+            return build(px)
+        except ValueError as e:
+            if "whole number of pixels" not in str(e):
+                raise
+            last = e
+    raise ValueError(f"{kind} target: no picture resolution puts every length on whole pixels "
+                     f"({last}); use lengths that are multiples of a common step")

@@ -411,3 +411,18 @@ def test_spec_layer_does_not_import_mitsuba():
             f"s = load_spec({str(EXAMPLES[0])!r}); resolve_views(s); spec_to_dict(s);"
             "bad = [m for m in ('mitsuba', 'drjit') if m in sys.modules]; assert not bad, bad")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+def test_docs_complete_example_parses(tmp_path):
+    doc = (ROOT / "docs" / "scene_spec.md").read_text()
+    text = doc.split("## Complete example")[1].split("```yaml\n")[1].split("```")[0]
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "bunny.ply").write_text(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    (tmp_path / "demo.yaml").write_text(text)
+    spec = load_spec(tmp_path / "demo.yaml")
+    views = resolve_views(spec)
+    assert len(views) == 24 + 2 * 5 + 2 * 10 + 1
+    assert views[24].name == "stereo_left_0024" and views[-1].name == "closeup_0039"

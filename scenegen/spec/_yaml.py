@@ -317,6 +317,13 @@ class Fields:
                 explicit[key] = knode.line
             self._keys[key] = (knode, owner.child(v, key))  # explicit keys override merged ones
 
+    @classmethod
+    def empty(cls, owner: Node) -> "Fields":
+        """No keys, errors located at ``owner`` (for shorthands like ``shape: sphere``)."""
+        f = cls.__new__(cls)
+        f.owner, f._keys = owner, {}
+        return f
+
     def check(self, required: Iterable[str] = (), optional: Iterable[str] = ()) -> "Fields":
         required, optional = list(required), list(optional)
         allowed = required + optional

@@ -17,7 +17,7 @@ from scenegen.conventions import matrix_from_quat_wxyz
 from scenegen.errors import SpecError
 from scenegen.pose import Rigid3, look_at, rotation_from_euler_deg
 from scenegen.spec import model as m
-from scenegen.spec._yaml import Document, Fields, Node, quoted_list, suggest
+from scenegen.spec._yaml import Document, Fields, Node, suggest
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
                   "cameras", "rigs", "views")
@@ -248,8 +248,7 @@ class _Parser:
             "blob": ("radius", "amplitude", "frequency", "subdivisions", "seed"),
         }[kind]
         if f is None:
-            f = Fields.__new__(Fields)
-            f.owner, f._keys = node, {}
+            f = Fields.empty(node)
         else:
             f.check(required=("type",), optional=keys)
 
@@ -723,4 +722,4 @@ def _check_with_camera_model(cam: m.CameraSpec, node: Node):
         raise node.error(f"impossible camera: {e}") from None
 
 
-__all__ = ["load_spec", "parse_spec", "derive_seed", "TOP_LEVEL_KEYS", "quoted_list"]
+__all__ = ["load_spec", "parse_spec", "derive_seed", "TOP_LEVEL_KEYS"]

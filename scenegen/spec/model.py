@@ -217,8 +217,8 @@ class ArucoGridTarget:
     marker_m: float  # side of one marker, metres
     separation_m: float  # gap between neighbouring markers, metres
     dictionary: str  # cv2.aruco predefined dictionary name
+    margin_m: float  # white border around the grid, metres (default: one separation)
     first_id: int = 0  # id of the first marker (ids run row by row)
-    margin_m: float = 0.0  # white border around the grid, metres (default: one separation)
     kind: str = field(default="aruco_grid", init=False)
 
 

@@ -30,3 +30,8 @@ def ring_of_cameras(n: int = 8, radius: float = 3.0, height: float = 1.0):
         Rs.append(R)
         ts.append(t)
     return np.array(Rs), np.array(ts)
+
+
+#: Unit square in the z = 0 plane as two triangles.
+SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])

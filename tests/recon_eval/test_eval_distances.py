@@ -10,8 +10,8 @@ from recon_eval.distances import (
 )
 from recon_eval.errors import InputError
 
-SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
-SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+from _recon_eval_helpers import SQUARE_F, SQUARE_V
+
 
 
 def brute_force(q, tri):

@@ -4,7 +4,7 @@ import pytest
 from recon_eval.errors import InputError
 from recon_eval.pointcloud import chamfer, dtu, eth3d, tanks_and_temples, voxel_downsample
 
-from test_eval_distances import SQUARE_F, SQUARE_V
+from _recon_eval_helpers import SQUARE_F, SQUARE_V
 
 
 def lattice(n=10):
