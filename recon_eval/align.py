@@ -68,8 +68,9 @@ class Sim3:
     def __matmul__(self, other: "Sim3") -> "Sim3":
         return Sim3(self.R @ other.R, self.scale * (self.R @ other.t) + self.t, self.scale * other.scale)
 
-    def cam_from_world_to_tgt(self, R_cam_from_src, t_cam_from_src):
-        """Re-express camera poses ``cam_from_src`` (R (..., 3, 3), t (..., 3)) as ``cam_from_tgt``.
+    def cam_from_tgt(self, R_cam_from_src, t_cam_from_src):
+        """Camera poses ``cam_from_src`` (R (..., 3, 3), t (..., 3)) re-expressed as ``cam_from_tgt``
+        (``self`` is ``tgt_from_src``); returns new arrays ``(R, t)``.
 
         With ``x_tgt = s R_a x_src + t_a`` a camera's centre maps like a point and its orientation
         rotates by R_a; the camera frame keeps metric units of the target:
@@ -223,7 +224,10 @@ def projective_align(points_src, points_tgt) -> Projective3:
         raise InputError(f"projective_align: need >= 5 corresponding points, got {Xs.shape[0]} and {Xt.shape[0]}")
     if not (np.all(np.isfinite(Xs)) and np.all(np.isfinite(Xt))):
         raise InputError("projective_align: points must be finite")
-    # Normalise the source in its affine chart (points at infinity are not expected here).
+    if np.any(Xs[:, 3] == 0):
+        raise InputError("projective_align: source points at infinity (w = 0) cannot be normalised")
+    # Work in the source's affine chart: dividing by w rescales each homogeneous point, which
+    # the projective H absorbs.
     Xs_e = Xs[:, :3] / Xs[:, 3:4]
     Ts, Tt = _normalising_transform(Xs_e), _normalising_transform(Xt)
     A_src = Xs_e @ Ts[:3, :3].T + Ts[:3, 3]
@@ -236,9 +240,7 @@ def projective_align(points_src, points_tgt) -> Projective3:
         A[i::3, 12:16] = -xt[:, i : i + 1] * xs
     _, _, Vt = np.linalg.svd(A)
     Hn = Vt[-1].reshape(4, 4)
-    H = np.linalg.inv(Tt) @ Hn @ Ts
-    # Undo the source dehomogenisation: it is a per-point scale, which H absorbs projectively.
-    return Projective3(H)
+    return Projective3(np.linalg.inv(Tt) @ Hn @ Ts)
 
 
 def cameras_to_truth_frame(P_src, tgt_from_src: Projective3) -> np.ndarray:

@@ -18,6 +18,7 @@ import numpy as np
 
 from recon_eval._arrays import as_float_array, frozen
 from recon_eval.errors import InputError
+from recon_eval.rotation import rotation_angle_rad
 
 
 @dataclass(frozen=True)
@@ -106,8 +107,6 @@ def projection_difference(cam_gt, cam_est, *, grid_nx: int = 60, grid_ny: int = 
     valid = np.isfinite(d)
     dv = d[valid]
     nan = float("nan")
-    from recon_eval.rotation import rotation_angle_rad
-
     return ProjectionDiffResult(
         float(np.mean(dv)) if len(dv) else nan, float(np.max(dv)) if len(dv) else nan,
         float(np.sqrt(np.mean(dv**2))) if len(dv) else nan,

@@ -5,7 +5,7 @@ what was expected, exit code 2, no traceback.
 Examples::
 
     recon-eval cloud REC.ply GT.ply --tau 0.01
-    recon-eval poses EST_MODEL_DIR GT_MODEL_DIR --alignment sim3     # COLMAP text models
+    recon-eval poses EST_MODEL_DIR GT_MODEL_DIR --alignment sim3     # COLMAP models (bin or txt)
     recon-eval poses est_tum.txt gt_tum.txt                          # TUM trajectories
     recon-eval disparity EST.png GT.png --benchmark kitti
     recon-eval depth EST.npy GT.npy --alignment median
@@ -42,8 +42,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--dtu-max-dist", type=float, default=0.02, help="DTU outlier cut, metres")
 
     p = add("poses", "camera poses: APE, RPE, registration ratio, relative-pose AUC and mAA")
-    p.add_argument("est", help="COLMAP text model directory or TUM trajectory file")
-    p.add_argument("gt", help="COLMAP text model directory or TUM trajectory file (same kind as est)")
+    p.add_argument("est", help="COLMAP model directory (binary or text) or TUM trajectory file")
+    p.add_argument("gt", help="COLMAP model directory (binary or text) or TUM trajectory file (same kind as est)")
     p.add_argument("--alignment", choices=["none", "se3", "sim3"], default="sim3")
     p.add_argument("--delta", type=int, default=1, help="RPE frame offset")
     p.add_argument("--max-time-diff", type=float, default=0.01, help="TUM timestamp association, seconds")
@@ -129,10 +129,14 @@ def _cmd_poses(a):
     if e.is_dir() != g.is_dir():
         raise InputError(f"{a.est} and {a.gt}: expected two COLMAP model directories or two TUM files")
     if g.is_dir():
+        from recon_eval.readers.colmap_binary import read_colmap_binary
         from recon_eval.readers.colmap_text import read_colmap_text
 
-        est, gt = read_colmap_text(e).poses, read_colmap_text(g).poses
-        kind = "colmap_text"
+        def read(d: Path):
+            return (read_colmap_binary(d) if (d / "images.bin").is_file() else read_colmap_text(d)).poses
+
+        est, gt = read(e), read(g)
+        kind = "colmap"
     else:
         from recon_eval.readers.tum import associate, read_tum
 

@@ -1,7 +1,7 @@
 """Depth-map metrics of Eigen et al. (NIPS 2014), with declared alignment, averaged per image.
 
 Definitions: shared/notes/metrics.md, "Depth maps". Depths are (H, W) float arrays in metres
-(z-depth). Truth pixels that are not finite or <= 0 (or outside [min_depth_m, max_depth_m]) are
+(z-depth). Truth pixels that are not finite or <= 0 (or outside (min_depth_m, max_depth_m)) are
 unknown and skipped. Predictions that are not finite or <= 0 after alignment are missing: they are
 excluded from the error terms and counted in ``coverage`` (never dropped silently).
 """
@@ -66,7 +66,8 @@ def eigen_depth_metrics(
 ) -> DepthResult:
     """Eigen et al. depth metrics (abs_rel, sq_rel, rmse, rmse_log (natural log), a1..a3 with
     strict ``<``), computed per image then averaged over images. Per-image alignment as declared.
-    Truth used where ``min_depth_m < g <= max_depth_m`` (strict below, as the usual 1e-3 cap).
+    Truth used where ``min_depth_m < g < max_depth_m`` (both strict, as monodepth2's
+    ``gt > MIN_DEPTH & gt < MAX_DEPTH``).
     depth_pred, depth_gt: sequences of (H, W) arrays, metres."""
     alignment = DepthAlignment(alignment)
     n = len(depth_pred)
@@ -79,7 +80,7 @@ def eigen_depth_metrics(
         g = as_float_array(depth_gt[k], f"GT depth #{k}", (None, None))
         if p.shape != g.shape:
             raise InputError(f"depth #{k}: prediction {p.shape} and truth {g.shape} differ in shape")
-        vg = np.isfinite(g) & (g > min_depth_m) & (g <= max_depth_m) & (g > 0)
+        vg = np.isfinite(g) & (g > min_depth_m) & (g < max_depth_m) & (g > 0)
         vp = vg & np.isfinite(p) & (p > 0)
         if vp.sum() == 0:
             per["coverage"][k] = 0.0

@@ -29,7 +29,7 @@ class DistanceTo(str, Enum):
     MESH = "mesh_surface"  # exact nearest point of the reference triangle mesh surface
 
 
-def nearest_point_distances(query, reference, *, workers: int = 1) -> np.ndarray:
+def nearest_point_distances(query, reference, *, workers: int = -1) -> np.ndarray:
     """Euclidean distance (N,) from each query point (N, 3) to its nearest reference point (M, 3);
     metres. Empty reference -> all inf."""
     q = as_float_array(query, "query points", (None, 3))

@@ -121,7 +121,7 @@ def ape(est: Poses, gt: Poses, *, alignment: Alignment = Alignment.SIM3) -> ApeR
     rerr = np.full(N, np.inf)
     reg = m.registered
     if np.any(reg):
-        R_al, t_al = T.cam_from_world_to_tgt(m.R_est[reg], m.t_est[reg])
+        R_al, t_al = T.cam_from_tgt(m.R_est[reg], m.t_est[reg])
         c_al = -np.einsum("nji,nj->ni", R_al, t_al)
         terr[reg] = np.linalg.norm(c_al - gt.centers_world[reg], axis=1)
         rerr[reg] = np.degrees(rotation_error_rad(R_al, gt.R_cam_from_world[reg]))
@@ -158,7 +158,7 @@ def rpe(est: Poses, gt: Poses, *, delta_frames: int = 1, alignment: Alignment = 
     N = len(gt.names)
     R_e, t_e = m.R_est.copy(), m.t_est.copy()
     if np.any(m.registered):
-        R_e[m.registered], t_e[m.registered] = T.cam_from_world_to_tgt(m.R_est[m.registered], m.t_est[m.registered])
+        R_e[m.registered], t_e[m.registered] = T.cam_from_tgt(m.R_est[m.registered], m.t_est[m.registered])
     i = np.arange(0, max(N - delta_frames, 0))
     j = i + delta_frames
 

@@ -7,7 +7,7 @@ The angle of a rotation matrix uses the atan2 form (metrics.md, "Rotation angle"
 ``|vee(R - R^T)| / 2 = sin(theta)`` and ``(trace(R) - 1) / 2 = cos(theta)``. Unlike
 ``arccos(clip((trace(R) - 1) / 2))`` it does not lose half the significant digits near 0
 (arccos(1 - e) ~ sqrt(2 e): a 1e-8 rad rotation reads as 0 or ~1.5e-8 with arccos in float64).
-It is also accurate near pi (there cos is well conditioned for atan2 via the sine).
+Near pi its absolute error stays at rounding level too.
 """
 from __future__ import annotations
 

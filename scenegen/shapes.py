@@ -137,7 +137,8 @@ def box(size_xyz=(1.0, 1.0, 1.0)) -> trimesh.Trimesh:
 
 
 def sphere(radius: float = 1.0, subdivisions: int = 32) -> trimesh.Trimesh:
-    """UV sphere centred at the origin: ``subdivisions`` latitude bands, 2 x that longitude segments.
+    """UV sphere centred at the origin: ``subdivisions`` latitude bands, twice as many longitude
+    segments.
 
     Spherical coordinates: theta from +z (north pole), phi = atan2(y, x) in [0, 2 pi);
     u = phi / (2 pi), v = theta / pi (north pole at the top row). The seam (phi = 0, +x side) is
@@ -321,7 +322,8 @@ def _spherical_corner_uv(v: np.ndarray, f: np.ndarray, side: np.ndarray) -> np.n
     cu = u_v[f].copy()  # (F, 3)
     cv = v_v[f]
     on_seam = (np.abs(y[f]) <= _ON_PLANE) & (x[f] > 0)
-    face_side = np.where(side != 0, side, np.sign(np.where(np.abs(y[f]) > _ON_PLANE, y[f], 0).sum(1)))
+    off_plane_y = np.where(np.abs(y[f]) > _ON_PLANE, y[f], 0.0)
+    face_side = np.where(side != 0, side, np.sign(off_plane_y.sum(1)))
     cu = np.where(on_seam & (face_side[:, None] < 0), 1.0, np.where(on_seam, 0.0, cu))
     pole = (x[f] ** 2 + y[f] ** 2) <= _ON_AXIS
     if pole.any():

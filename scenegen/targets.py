@@ -49,8 +49,8 @@ BOARD_KINDS = ("checkerboard", "charuco", "aruco")
 # OpenCV stores board object points as float32: ~6e-8 relative; at board sizes of a few metres
 # that is < 1e-6 m.
 _CV_OBJPOINT_TOL_M = 1e-6
-# Physical lengths must land on whole pixels to this relative precision (float rounding of
-# products like 0.03 / 0.04 * 100).
+# Physical lengths must land on whole pixels to within this many pixels (float rounding of
+# products like 0.03 / 0.04 * 100 is ~1e-13 px; a 1e-6 px misplacement is far below any test).
 _WHOLE_PX_TOL = 1e-6
 
 
@@ -203,7 +203,7 @@ def _dictionary(name: str):
 
 def _whole_px(name: str, value_px: float) -> int:
     n = int(round(value_px))
-    if abs(value_px - n) > _WHOLE_PX_TOL * max(1.0, abs(value_px)) or n < 0:
+    if abs(value_px - n) > _WHOLE_PX_TOL or n < 0:
         raise ValueError(f"{name} is {value_px:.6g} px; it must be a whole number of pixels "
                          "(choose px_per_square / px_per_marker to make it one)")
     return n

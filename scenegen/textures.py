@@ -34,7 +34,8 @@ def _size_wh(size_px) -> tuple[int, int]:
         try:
             w, h = (int(s) for s in size_px)
         except (TypeError, ValueError):
-            raise ValueError(f"size_px must be an int or (width, height), got {size_px!r}") from None
+            raise ValueError(f"size_px must be an int or (width, height), got {size_px!r}") \
+                from None
     if w < 1 or h < 1:
         raise ValueError(f"size_px must be positive, got {size_px!r}")
     return w, h
@@ -171,9 +172,9 @@ def noise(size_px=256, seed: int = 0, octaves: int = 5, base_cells: int = 4,
 def _splat_discs(width, height, cx, cy, radius, values, combine):
     """Rasterise antialiased discs onto a periodic (H, W) canvas, vectorised over discs.
 
-    Each disc i covers pixel centres with coverage clip(radius_i + 0.5 - distance, 0, 1) (a one-pixel
-    linear ramp: the covered area equals pi r^2 to within O(1/r)). ``combine='max'`` stores
-    max(coverage * values_i) per pixel; ``combine='index'`` stores, per pixel, the largest disc
+    Each disc i covers pixel centres with coverage clip(radius_i + 0.5 - distance, 0, 1) (a
+    one-pixel linear ramp: the covered area equals pi r^2 to within O(1/r)). ``combine='max'``
+    stores max(coverage * values_i) per pixel; ``combine='index'`` stores, per pixel, the largest disc
     index i whose coverage is >= 0.5 (-1 where none), i.e. the last-drawn disc is on top.
     Discs are processed in groups of similar radius so the per-disc pixel window stays small.
     """

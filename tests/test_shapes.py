@@ -168,7 +168,7 @@ class TestTorus:
         R, r, n, k = 1.0, 0.3, 48, 20
         m = shapes.torus(R, r, n, k)
         # Each of the n segments is the k-gon cross-section swept between two planes; its volume is
-        # sin(2 pi / n) R A(k-gon) (derivation in the docstring of shapes.torus), so the polyhedron's
+        # sin(2 pi / n) R A(k-gon) (derived in the docstring of shapes.torus), so the polyhedron's
         # volume is 2 pi^2 R r^2 sinc(2 pi / n) sinc(2 pi / k).
         factor = _sinc(2 * np.pi / n) * _sinc(2 * np.pi / k)
         exact = 2 * np.pi**2 * R * r**2

@@ -205,3 +205,56 @@ def test_opencv_calibration_convention():
     assert np.allclose(proj.reshape(-1, 2), b.points_image_px(), atol=1e-9)
     # The camera centre is at board z = -1 (the -z side), where the mesh normal points.
     assert b.mesh().face_normals[0] @ np.array([0, 0, -1.0]) > 0
+
+
+class TestSpecIntegration:
+    def test_object_from_board_centres_and_faces_plus_z(self):
+        b = targets.charuco_board(5, 4, 0.04, 0.03, px_per_square=60)
+        T = b.object_from_board()
+        mesh = b.mesh()
+        v_obj = T.apply(mesh.vertices)
+        assert np.allclose(v_obj.mean(axis=0), 0)
+        n_obj = mesh.face_normals @ T.R.T
+        assert np.allclose(n_obj, [0, 0, 1])
+        # Upright seen from +z with +y up: the picture's top-left corner is at (-w/2, +h/2).
+        assert np.allclose(T.apply(np.zeros((1, 3))), [[-b.width_m / 2, b.height_m / 2, 0]])
+        # The same placement as shapes.plane: identical (position, uv) pairs.
+        from scenegen import shapes
+
+        plane = shapes.plane((b.width_m, b.height_m))
+        key = lambda v, uv: sorted(map(tuple, np.round(np.c_[v, uv], 9)))  # noqa: E731
+        assert key(v_obj, mesh.visual.uv) == key(plane.vertices, plane.visual.uv)
+
+    def test_board_from_spec_dataclasses(self):
+        from scenegen.spec import model as m
+
+        cb = targets.board_from_spec(m.CheckerboardTarget(inner_cols=6, inner_rows=4,
+                                                          square_m=0.03, margin_m=0.0123))
+        assert cb.kind == "checkerboard" and cb.margin_m == pytest.approx(0.0123)
+        ok, found = cv2.findChessboardCorners(cb.image, (6, 4))
+        assert ok and np.abs(_subpix(cb.image, found).reshape(-1, 2)
+                             - cb.points_image_px()).max() < CORNER_TOL_PX
+        ch = targets.board_from_spec(m.CharucoTarget(squares_x=5, squares_y=4, square_m=0.04,
+                                                     marker_m=0.03, dictionary="DICT_4X4_50",
+                                                     margin_m=0.04))
+        assert ch.kind == "charuco" and ch.margin_m == pytest.approx(0.04)
+        ar = targets.board_from_spec(m.ArucoGridTarget(markers_x=3, markers_y=2, marker_m=0.05,
+                                                       separation_m=0.01, dictionary="DICT_4X4_50",
+                                                       margin_m=0.01, first_id=7))
+        assert ar.kind == "aruco" and list(ar.marker_ids) == list(range(7, 13))
+        corners, ids, _ = _aruco_detector("DICT_4X4_50").detectMarkers(ar.image)
+        assert sorted(ids.ravel()) == list(range(7, 13))
+        truth = dict(zip(ar.marker_ids, ar.marker_corners_image_px()))
+        assert max(np.abs(c.reshape(4, 2) - truth[i]).max()
+                   for c, i in zip(corners, ids.ravel())) < MARKER_TOL_PX
+        assert np.array_equal(np.asarray(ar.cv2_board().getIds()).ravel(), ar.marker_ids)
+
+    def test_board_from_spec_rejects_irrational_lengths(self):
+        from types import SimpleNamespace
+
+        t = SimpleNamespace(kind="checkerboard", inner_cols=4, inner_rows=3, square_m=0.03,
+                            margin_m=0.03 / np.pi)
+        with pytest.raises(ValueError, match="checkerboard target: no picture resolution"):
+            targets.board_from_spec(t)
+        with pytest.raises(ValueError, match="unknown calibration target kind"):
+            targets.board_from_spec(SimpleNamespace(kind="circles"))

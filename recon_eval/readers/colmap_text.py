@@ -15,6 +15,7 @@ import numpy as np
 from recon_eval.errors import InputError
 from recon_eval.poses import Poses
 from recon_eval.readers._quat import matrix_from_quat_wxyz
+from recon_eval.readers._text import read_text
 
 #: COLMAP model -> index of (cx, cy) in its parameter list
 _PRINCIPAL_POINT = {
@@ -42,8 +43,18 @@ class ColmapModel:
     points_world: np.ndarray  # (P, 3) metres (points3D.txt; empty if the file is absent)
 
 
+def make_camera(camera_id: int, model: str, width: int, height: int, params) -> ColmapCamera:
+    """A :class:`ColmapCamera` with the OpenCV-convention copy of the parameters."""
+    params = tuple(float(v) for v in params)
+    cv = list(params)
+    if model in _PRINCIPAL_POINT and len(cv) > max(_PRINCIPAL_POINT[model]):
+        for i in _PRINCIPAL_POINT[model]:
+            cv[i] -= 0.5
+    return ColmapCamera(camera_id, model, width, height, params, tuple(cv))
+
+
 def _lines(path: Path) -> list[str]:
-    return [ln.rstrip("\n") for ln in path.read_text().splitlines() if not ln.lstrip().startswith("#")]
+    return [ln.rstrip("\n") for ln in read_text(path, "a COLMAP text model file").splitlines() if not ln.lstrip().startswith("#")]
 
 
 def read_colmap_text(model_dir) -> ColmapModel:
@@ -63,11 +74,7 @@ def read_colmap_text(model_dir) -> ColmapModel:
             params = tuple(float(v) for v in tok[4:])
         except (ValueError, IndexError):
             raise InputError(f"{d / 'cameras.txt'}: bad line {ln!r} (expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS...)") from None
-        cv = list(params)
-        if model in _PRINCIPAL_POINT and len(cv) > max(_PRINCIPAL_POINT[model]):
-            for i in _PRINCIPAL_POINT[model]:
-                cv[i] -= 0.5
-        cams[cid] = ColmapCamera(cid, model, w, h, params, tuple(cv))
+        cams[cid] = make_camera(cid, model, w, h, params)
     names, qs, ts, cids = [], [], [], []
     lines = _lines(d / "images.txt")
     i = 0

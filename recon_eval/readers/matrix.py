@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
+from recon_eval.readers._text import read_text
 from recon_eval.readers.npy import read_npy
 
 
@@ -17,7 +18,7 @@ def read_matrix3(path, key: str | None = None) -> np.ndarray:
         raise InputError(f"{p}: no such file (expected a 3x3 matrix as .npy, .json or .txt)")
     if p.suffix.lower() == ".npy":
         return read_npy(p, (3, 3))
-    text = p.read_text()
+    text = read_text(p, "a 3x3 matrix as text or JSON")
     if p.suffix.lower() == ".json":
         try:
             obj = json.loads(text)

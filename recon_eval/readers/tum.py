@@ -14,6 +14,7 @@ import numpy as np
 from recon_eval.errors import InputError
 from recon_eval.poses import Poses
 from recon_eval.readers._quat import matrix_from_quat_wxyz
+from recon_eval.readers._text import read_text
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,7 @@ def read_tum(path) -> TumTrajectory:
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a TUM trajectory: timestamp tx ty tz qx qy qz qw)")
     rows = []
-    for k, ln in enumerate(p.read_text().splitlines(), start=1):
+    for k, ln in enumerate(read_text(p, "a TUM trajectory").splitlines(), start=1):
         ln = ln.split("#", 1)[0].replace(",", " ").strip()
         if not ln:
             continue

@@ -43,10 +43,13 @@ def _rgb(c) -> dict:
     return {"type": "rgb", "value": [float(x) for x in c]}
 
 
-def _bitmap(img: np.ndarray) -> dict:
-    """Linear float32 (H, W, 3) reflectance as a raw (non-sRGB) Mitsuba bitmap texture."""
+def _bitmap(img: np.ndarray, wrap_mode: str = "repeat") -> dict:
+    """Linear float32 (H, W, 3) reflectance as a raw (non-sRGB) Mitsuba bitmap texture.
+
+    Procedural textures tile seamlessly, so they repeat (no visible UV seam on spheres and tori);
+    board pictures clamp, so no opposite edge bleeds into the board's border."""
     return {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)),
-            "raw": True, "filter_type": "bilinear", "wrap_mode": "clamp"}
+            "raw": True, "filter_type": "bilinear", "wrap_mode": wrap_mode}
 
 
 def texture_image(tex: m.Texture) -> np.ndarray:
@@ -80,7 +83,7 @@ def material_dict(mat) -> dict:
 def board_material(board) -> dict:
     img = board.image.astype(np.float32) / 255.0
     refl = BOARD_BLACK + (BOARD_WHITE - BOARD_BLACK) * img
-    return {"type": "diffuse", "reflectance": _bitmap(np.repeat(refl[..., None], 3, axis=2))}
+    return {"type": "diffuse", "reflectance": _bitmap(np.repeat(refl[..., None], 3, axis=2), "clamp")}
 
 
 def geometry_mesh(geom, spec_seed: int = 0):
@@ -92,8 +95,7 @@ def geometry_mesh(geom, spec_seed: int = 0):
     if isinstance(geom, m.Sphere):
         return shapes.sphere(geom.radius), None
     if isinstance(geom, m.Cylinder):
-        return shapes.cylinder(geom.radius, geom.height, capped=geom.capped) if _accepts(shapes.cylinder, "capped") \
-            else shapes.cylinder(geom.radius, geom.height), None
+        return shapes.cylinder(geom.radius, geom.height), None
     if isinstance(geom, m.Torus):
         return shapes.torus(geom.major_radius, geom.minor_radius), None
     if isinstance(geom, m.Blob):
@@ -103,13 +105,10 @@ def geometry_mesh(geom, spec_seed: int = 0):
     from scenegen import targets
 
     board = targets.board_from_spec(geom)
-    return board.mesh(), board
-
-
-def _accepts(fn, name: str) -> bool:
-    import inspect
-
-    return name in inspect.signature(fn).parameters
+    # the spec's target object is the board centred on its origin, print facing +z
+    mesh = board.mesh()
+    mesh.vertices = board.object_from_board().apply(mesh.vertices)
+    return mesh, board
 
 
 def _place(mesh: trimesh.Trimesh, tf: m.Transform) -> trimesh.Trimesh:
@@ -171,7 +170,7 @@ def object_entry(obj: m.SceneObject, built: BuiltScene) -> dict:
     if board is not None:
         if not np.allclose(obj.transform.scale, 1.0):
             raise ValueError(f"object {obj.name!r}: calibration targets cannot be scaled (their size is exact)")
-        built.boards[obj.name] = (board, obj.transform.world_from_object)
+        built.boards[obj.name] = (board, obj.transform.world_from_object @ board.object_from_board())
         bsdf = board_material(board)
     smooth = isinstance(geom, _SMOOTH) or (isinstance(geom, m.Mesh) and len(world.faces) > 0 and
                                            not _is_faceted(local))

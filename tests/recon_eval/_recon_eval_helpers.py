@@ -35,3 +35,19 @@ def ring_of_cameras(n: int = 8, radius: float = 3.0, height: float = 1.0):
 #: Unit square in the z = 0 plane as two triangles.
 SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
 SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def _num(values) -> str:
+    return " ".join(f"{float(v):.17g}" for v in values)
+
+
+def write_colmap(d, qs, ts):
+    d.mkdir()
+    (d / "cameras.txt").write_text("# cams\n1 PINHOLE 640 480 500 505 320 240\n")
+    lines = ["# images"]
+    for k, (q, t) in enumerate(zip(qs, ts), start=1):
+        lines.append(f"{k} {_num(q)} {_num(t)} 1 img{k}.png")
+        lines.append("" if k % 2 else "100.0 200.0 -1 5.0 6.0 1")
+    (d / "images.txt").write_text("\n".join(lines) + "\n")
+    # point 1 is observed by image 2's second keypoint (its POINTS2D line references point 1)
+    (d / "points3D.txt").write_text("# pts\n1 0.1 0.2 3.0 255 0 0 0.5 2 1\n")

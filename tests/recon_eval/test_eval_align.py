@@ -79,7 +79,7 @@ class TestSim3:
         rng = np.random.default_rng(6)
         R, t = ring_of_cameras(4)
         A = Sim3(random_rotation(rng), rng.normal(size=3), 0.5)
-        R2, t2 = A.cam_from_world_to_tgt(R, t)
+        R2, t2 = A.cam_from_tgt(R, t)
         X = rng.normal(size=(4, 3))  # a world point seen by every camera
         for k in range(4):
             x_cam = R[k] @ X[k] + t[k]

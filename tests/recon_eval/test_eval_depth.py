@@ -60,3 +60,10 @@ def test_image_without_valid_pixels_is_counted():
 def test_shape_mismatch():
     with pytest.raises(InputError, match="differ in shape"):
         eigen_depth_metrics([np.ones((2, 3))], [GT])
+
+
+def test_depth_range_is_open():
+    g = np.array([[1.0, 2.0, 3.0]])
+    p = np.array([[1.0, 4.0, 3.0]])  # only the middle pixel is wrong
+    r = eigen_depth_metrics([p], [g], min_depth_m=1.0, max_depth_m=3.0)
+    assert r.abs_rel == 1.0  # 1 and 3 are outside (1, 3): only g = 2 is scored

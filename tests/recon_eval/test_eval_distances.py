@@ -61,3 +61,23 @@ def test_nearest_point_distances():
     d = nearest_point_distances([[0.0, 0, 0], [3, 0, 0]], [[1.0, 0, 0], [5, 0, 0]])
     np.testing.assert_array_equal(d, [1.0, 2.0])
     assert np.all(np.isinf(nearest_point_distances(np.zeros((3, 3)), np.zeros((0, 3)))))
+
+
+class TestClosestPointOnTriangle:
+    def test_matches_trimesh(self):
+        # trimesh.triangles.closest_point: an independent vectorised implementation
+        rng = np.random.default_rng(5)
+        tri = rng.normal(size=(2000, 3, 3))
+        p = rng.normal(size=(2000, 3)) * 2.0
+        ours = closest_points_on_triangles(p, tri[:, 0], tri[:, 1], tri[:, 2])
+        np.testing.assert_allclose(ours, trimesh.triangles.closest_point(tri, p), atol=1e-12)
+
+    def test_degenerate_triangles_give_segment_distances(self):
+        # collinear vertices: the "triangle" is the segment [0, 2] on the x axis
+        a, b, c = np.array([[0.0, 0, 0]]), np.array([[1.0, 0, 0]]), np.array([[2.0, 0, 0]])
+        for p, d in (([1.5, 1.0, 0.0], 1.0), ([3.0, 0.0, 0.0], 1.0), ([-1.0, 0.0, 1.0], np.sqrt(2)), ([0.3, 0.0, 0.0], 0.0)):
+            q = closest_points_on_triangles(np.array([p]), a, b, c)
+            assert np.linalg.norm(q - p) == pytest.approx(d, abs=1e-15)
+        same = np.zeros((1, 3))
+        q = closest_points_on_triangles(np.array([[1.0, 2.0, 2.0]]), same, same, same)
+        np.testing.assert_array_equal(q, same)

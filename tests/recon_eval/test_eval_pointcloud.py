@@ -68,6 +68,19 @@ def test_voxel_downsample_hand_computed():
     np.testing.assert_allclose(out, [[0.05, 0, 0], [1.0, 0, 0]])
 
 
+@pytest.mark.parametrize("span_m", [10.0, 1e6])  # 1e6 m at 1 um voxels takes the wide-grid path
+def test_voxel_downsample_matches_a_dictionary_grouping(span_m):
+    rng = np.random.default_rng(1)
+    p = rng.integers(0, 5, size=(300, 3)) * (span_m / 5) + rng.random((300, 3)) * 1e-7
+    voxel = 1e-6 if span_m > 100 else 0.5
+    origin = p.min(axis=0) - voxel / 2
+    groups = {}
+    for q in p:
+        groups.setdefault(tuple(np.floor((q - origin) / voxel).astype(np.int64)), []).append(q)
+    expected = np.array([np.mean(groups[k], axis=0) for k in sorted(groups)])
+    np.testing.assert_allclose(voxel_downsample(p, voxel), expected, rtol=0, atol=1e-9)
+
+
 class TestEth3d:
     def test_inclusive_operator_at_the_tie(self):
         gt = lattice()

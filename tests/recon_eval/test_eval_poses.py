@@ -19,7 +19,7 @@ def truth() -> Poses:
 
 
 def planted_estimate(gt: Poses) -> Poses:
-    R, t = PLANTED.cam_from_world_to_tgt(gt.R_cam_from_world, gt.t_cam_from_world)
+    R, t = PLANTED.cam_from_tgt(gt.R_cam_from_world, gt.t_cam_from_world)
     return Poses(gt.names, R, t)
 
 
