@@ -133,6 +133,10 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                               truth=_truth_for_storage(truth))
             rendered += 1
             bar.advance()
+    from scenegen.crossview.stage import run_crossview  # cross-view truth (docs/crossview.md)
+
+    run_crossview(spec, views, built, writer, encode_image=lambda lin: encode_image(lin, rs.bit_depth),
+                  spp=spp, seed=seed)
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)
 

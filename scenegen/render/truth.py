@@ -4,7 +4,8 @@ Not Mitsuba's ``aov`` integrator: its depth is neither z-depth nor range and it 
 the reconstruction filter. Here each pixel centre (u, v) = (column, row) in OpenCV's convention
 is unprojected in float64 by :class:`scenegen.camera.Camera` (the same arithmetic as the
 renderer's sensor), rotated into the world, intersected with the scene in float32 by Mitsuba,
-and every output is derived in float64 in ONE Dr.Jit kernel:
+and every output is derived in float64 in ONE Dr.Jit kernel (range and depth_z are returned in
+float64; points, normals and uv are rounded once to float32, the precision they are stored in):
 
 * ``range``: distance from the optical centre to the hit (metres) = Mitsuba's ``si.t`` along
   the unit ray; ``depth_z`` = range * ray_z, z along the optical axis (metres).
@@ -78,7 +79,9 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict
     d_cam = _camera_rays_dr(camera)
     d_world = _matvec(Rwc, d_cam)
     ray = mi.Ray3f(mi.Point3f(mi.Vector3f(C)), mi.Vector3f(d_world))
-    si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=True)
+    # only what the outputs need: position, uv and the shading normal (no dP/dUV derivatives)
+    si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.Minimal | mi.RayFlags.UV | mi.RayFlags.ShadingFrame,
+                             coherent=True)
     hit = si.is_valid()
     nan64 = dr.nan if hasattr(dr, "nan") else math.nan
     t = dr.select(hit, mi.Float64(si.t), dr.inf)
@@ -95,22 +98,13 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict
     obj = dr.select(hit, dr.gather(mi.UInt32, obj_table, sid), 0)
     inst = dr.select(hit, dr.gather(mi.UInt32, inst_table, sid), 0)
     depth_z = t * d_cam.z
-    outputs = (t, depth_z, points_cam, points_world, n_world, n_cam, uv, obj, inst, hit)
-    dr.eval(*outputs)  # one kernel for everything; convert only afterwards
-
-    def img(x, c=None):
-        a = np.array(x)
-        return a.reshape(H, W) if c is None else a.T.reshape(H, W, c) if a.shape[0] == c else a.reshape(H, W, c)
-
-    return {
-        "range": img(t).astype(np.float64),
-        "depth_z": img(depth_z),
-        "points_cam": img(points_cam, 3),
-        "points_world": img(points_world, 3),
-        "normals_world": img(n_world, 3),
-        "normals_cam": img(n_cam, 3),
-        "uv": img(uv, 2).astype(np.float32),
-        "object_id": img(obj).astype(np.uint32),
-        "instance_id": img(inst).astype(np.uint32),
-        "valid": img(hit).astype(bool),
-    }
+    # vectors are rounded once to float32 (the stored precision) inside the kernel; range and
+    # depth_z stay float64, so float64 points are C + range * ray when a caller needs them
+    vectors = {"points_cam": mi.Vector3f(points_cam), "points_world": mi.Vector3f(points_world),
+               "normals_world": mi.Vector3f(n_world), "normals_cam": mi.Vector3f(n_cam), "uv": uv}
+    scalars = {"range": t, "depth_z": depth_z, "object_id": obj, "instance_id": inst, "valid": hit}
+    dr.eval(*vectors.values(), *scalars.values())  # one kernel for everything; convert only afterwards
+    # .numpy() of an evaluated flat array is a zero-copy view; vectors are stacked per component
+    out = {k: np.stack([c.numpy() for c in v], axis=-1).reshape(H, W, len(v)) for k, v in vectors.items()}
+    out.update({k: v.numpy().reshape(H, W) for k, v in scalars.items()})
+    return out

@@ -20,7 +20,7 @@ from scenegen.spec import model as m
 from scenegen.spec._yaml import Document, Fields, Node, suggest
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views")
+                  "cameras", "rigs", "views", "crossview")
 _SEED_MAX = 2**32 - 1
 _ID_MAX = 2**31 - 1
 
@@ -81,6 +81,7 @@ class _Parser:
         description = f.get("description").as_str() if "description" in f else ""
         self.seed = f.int("seed", 0, lo=0, hi=_SEED_MAX)
         render = self.render(f.get("render"))
+        self.render_bit_depth = render.bit_depth  # default output bits of a camera's imaging chain
         materials = self.named_section(f, "materials", self.material)
         cameras = self.named_section(f, "cameras", self.camera)
         self.cameras = cameras
@@ -90,16 +91,83 @@ class _Parser:
         lights = self.list_section(f, "lights", self.light)
         _unique_names(f.get("lights"), lights, "light")
         view_sets = self.list_section(f, "views", self.view_set, cameras, rigs)
+        crossview = self.crossview(f.get("crossview")) if "crossview" in f else None
         spec = m.SceneSpec(
             name=name, description=description, seed=self.seed, render=render,
             materials=m.frozen_mapping(materials), objects=tuple(objects), lights=tuple(lights),
             cameras=m.frozen_mapping(cameras), rigs=m.frozen_mapping(rigs),
             view_sets=tuple(view_sets), file=self.doc.file, base_dir=self.doc.base_dir,
-            warnings=tuple(self.warnings))
+            warnings=tuple(self.warnings), crossview=crossview)
         from scenegen.spec.views import resolve_views
 
-        resolve_views(spec)  # degenerate placements are errors now, not at render time
+        views = resolve_views(spec)  # degenerate placements are errors now, not at render time
+        self.check_crossview_pairs(views)
         return spec
+
+    # -- cross-view truth (docs/crossview.md) ------------------------------------------------
+    def crossview(self, node: Node) -> m.CrossviewSpec:
+        f = node.as_mapping("a crossview section (pairs, flow, stereo, matches, sift, ...)")
+        f.check(optional=("pairs", "flow", "stereo", "matches", "sift", "sift_ratio",
+                          "sift_inlier_px", "targets"))
+        self._crossview_pairs: list = []
+        pairs: object = "consecutive"
+        pn = f.get("pairs")
+        if pn is not None and pn.is_sequence:
+            out = []
+            for item in pn.items("a list of [view_a, view_b] pairs"):
+                names = item.items("a pair [view_a, view_b] of view names")
+                if len(names) != 2:
+                    raise item.error(f"expected a pair [view_a, view_b] of view names, got "
+                                     f"{len(names)} items")
+                a, b = (n.as_str("a view name") for n in names)
+                if a == b:
+                    raise names[1].error(f"a pair needs two different views, got {a!r} twice")
+                out.append((a, b))
+                self._crossview_pairs.extend(zip((a, b), names))
+            if not out:
+                raise pn.error("expected at least one pair, got an empty list (use pairs: none)")
+            pairs = tuple(out)
+        elif pn is not None:
+            pairs = pn.as_enum(m.CROSSVIEW_PAIR_MODES, "pair selection (or a list of pairs)")
+
+        def flag(key, default):
+            return f.get(key).as_bool() if key in f else default
+
+        matches = None
+        if "matches" in f:
+            mf = f.get("matches").as_mapping("a match-set mapping (count, sigma_px, ...)").check(
+                optional=("count", "sigma_px", "outlier_fraction", "near_miss_fraction",
+                          "near_miss_px", "seed"))
+            near = (4.0, 16.0)
+            if "near_miss_px" in mf:
+                near = mf.get("near_miss_px").as_floats(2, "min and max distance, pixels", lo=0.0,
+                                                       lo_open=True)
+                if near[0] > near[1]:
+                    raise mf.get("near_miss_px").error(f"expected min <= max, got {list(near)}")
+            seed = mf.int("seed", None, lo=0, hi=_SEED_MAX)
+            matches = m.MatchSetSpec(
+                count=mf.int("count", 1000, "matches per pair", lo=1),
+                sigma_px=mf.float("sigma_px", 0.5, "pixels", lo=0.0),
+                outlier_fraction=mf.float("outlier_fraction", 0.2, "fraction", lo=0.0, hi=1.0,
+                                          hi_open=True),
+                near_miss_fraction=mf.float("near_miss_fraction", 0.5, "fraction", lo=0.0, hi=1.0),
+                near_miss_px=near,
+                seed=derive_seed(self.seed, f.get("matches").path) if seed is None else seed,
+                where=f.get("matches").where)
+        return m.CrossviewSpec(
+            pairs=pairs, flow=flag("flow", True), stereo=flag("stereo", True), matches=matches,
+            sift=flag("sift", False),
+            sift_ratio=f.float("sift_ratio", 0.8, "Lowe ratio", lo=0.0, lo_open=True, hi=1.0),
+            sift_inlier_px=f.float("sift_inlier_px", 2.0, "pixels", lo=0.0, lo_open=True),
+            targets=flag("targets", True), where=node.where)
+
+    def check_crossview_pairs(self, views) -> None:
+        """Explicit crossview pairs must name resolved views."""
+        names = [v.name for v in views]
+        for name, node in getattr(self, "_crossview_pairs", ()):
+            if name not in names:
+                shown = ", ".join(names[:8]) + (", ..." if len(names) > 8 else "") or "none"
+                raise node.error(f"undefined view {name!r}{suggest(name, names)}; views: {shown}")
 
     def named_section(self, f: Fields, key: str, parse) -> dict:
         node = f.get(key)
@@ -447,7 +515,7 @@ class _Parser:
     def camera(self, node: Node, name: str) -> m.CameraSpec:
         f = node.as_mapping("a camera (a mapping with model, size and fx, fy or fov_deg)")
         f.check(required=("size",),
-                optional=("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist"))
+                optional=("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "imaging"))
         model = f.get("model").as_enum(m.CAMERA_MODELS, "camera model") if "model" in f \
             else "pinhole"
         size_node = f.get("size")
@@ -490,7 +558,8 @@ class _Parser:
         elif model != "pinhole":
             dist = (0.0,) * allowed[0]
         cam = m.CameraSpec(name=name, model=model, width=W, height=H, fx=fx, fy=fy, cx=cx, cy=cy,
-                           skew=skew, dist=dist, fov_deg=fov, where=node.where)
+                           skew=skew, dist=dist, fov_deg=fov, where=node.where,
+                           imaging=self.imaging(f.get("imaging"), name) if "imaging" in f else None)
         if not (-0.5 <= cx <= W - 0.5 and -0.5 <= cy <= H - 0.5):
             self.warn(node, f"principal point ({cx:g}, {cy:g}) lies outside the image")
         _check_with_camera_model(cam, f.get("dist") or node)

@@ -331,6 +331,9 @@ class CameraSpec:
     dist: tuple[float, ...] = ()  # distortion coefficients (unitless), see above
     fov_deg: float | None = None  # horizontal FoV of the undistorted pinhole as written (fx, fy
     # derived from it: fx = fy = (W/2) / tan(fov/2)), degrees
+    imaging: Any = None  # scenegen.imaging.ImagingParams: the photometric chain (exposure,
+    # vignetting, EMVA 1288 sensor, Bayer, response; docs/image_formation.md); None = the clean
+    # sRGB encoding of the linear render
     where: Where | None = field(**_WHERE)
 
     @property
@@ -468,6 +471,40 @@ class View:
 
 
 # ---------------------------------------------------------------------------------------------
+# cross-view truth (docs/crossview.md)
+CROSSVIEW_PAIR_MODES = ("consecutive", "all", "none")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MatchSetSpec:
+    """Putative match sets sampled from visible truth correspondences (per selected pair)."""
+
+    count: int = 1000  # matches per pair (fewer when fewer pixels are visible)
+    sigma_px: float = 0.5  # Gaussian noise of inliers, px, per coordinate of both points
+    outlier_fraction: float = 0.2  # share of outliers, in [0, 1)
+    near_miss_fraction: float = 0.5  # share of the outliers that are near misses, in [0, 1]
+    near_miss_px: tuple[float, float] = (4.0, 16.0)  # near-miss distance range from the truth, px
+    seed: int = 0  # explicit, or derived from the scene seed and field path
+    where: Where | None = field(**_WHERE)
+
+
+@dataclass(frozen=True, kw_only=True)
+class CrossviewSpec:
+    """What cross-view truth to write (the optional top-level ``crossview:`` section)."""
+
+    pairs: Union[str, tuple[tuple[str, str], ...]] = "consecutive"  # CROSSVIEW_PAIR_MODES or
+    # explicit (view_a, view_b) names; dense correspondences both ways + two-view geometry
+    flow: bool = True  # Middlebury .flo flow between consecutive frames of each camera stream
+    stereo: bool = True  # rectified renders, disparity and maps for every stereo-rig frame
+    matches: MatchSetSpec | None = None  # synthetic labelled match sets per pair (None = off)
+    sift: bool = False  # OpenCV SIFT matches per pair, labelled against the truth
+    sift_ratio: float = 0.8  # Lowe's ratio test threshold, in (0, 1]
+    sift_inlier_px: float = 2.0  # a SIFT match is an inlier within this distance of the truth, px
+    targets: bool = True  # per-view calibration-board corner truth (when the scene has boards)
+    where: Where | None = field(**_WHERE)
+
+
+# ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True, kw_only=True, eq=False)
 class SceneSpec:
     name: str  # scene name (default: the spec file's stem)
@@ -483,3 +520,4 @@ class SceneSpec:
     file: str | None = None  # the spec file as named by the user ('<string>' for text)
     base_dir: Path = field(default_factory=Path.cwd)  # directory relative paths resolve against
     warnings: tuple[str, ...] = ()  # non-fatal remarks, each 'file:line: field: message'
+    crossview: CrossviewSpec | None = None  # cross-view truth to write; None = none

@@ -1,0 +1,35 @@
+"""Middlebury ``.flo`` optical flow files (Baker et al., "A Database and Evaluation Methodology
+for Optical Flow", IJCV 2011, and its flow-code readme).
+
+Layout: float32 magic 202021.25 (bytes ``PIEH``), int32 width, int32 height, then H * W * 2
+float32 (u, v) interleaved, row-major from the top row; all little-endian. Unknown flow is
+stored as 1e10 (readers treat |value| > 1e9 as unknown).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+FLO_MAGIC = 202021.25
+UNKNOWN_FLOW = 1e10
+UNKNOWN_FLOW_THRESH = 1e9
+
+
+def encode_flo(flow) -> bytes:
+    """Bytes of an (H, W, 2) flow (pixels, u right, v down); NaN -> UNKNOWN_FLOW."""
+    f = np.asarray(flow, np.float64)
+    if f.ndim != 3 or f.shape[2] != 2:
+        raise ValueError(f"flow must be (H, W, 2), got {f.shape}")
+    H, W, _ = f.shape
+    f = np.where(np.isfinite(f), f, UNKNOWN_FLOW).astype("<f4")
+    head = np.array([FLO_MAGIC], "<f4").tobytes() + np.array([W, H], "<i4").tobytes()
+    return head + np.ascontiguousarray(f).tobytes()
+
+
+def decode_flo(data: bytes) -> np.ndarray:
+    """(H, W, 2) float32 flow with unknown values (|x| > 1e9) as NaN."""
+    magic = np.frombuffer(data, "<f4", count=1)[0]
+    if magic != np.float32(FLO_MAGIC):
+        raise ValueError(f"not a .flo file (magic {magic!r})")
+    W, H = (int(x) for x in np.frombuffer(data, "<i4", count=2, offset=4))
+    f = np.frombuffer(data, "<f4", count=H * W * 2, offset=12).reshape(H, W, 2).astype(np.float32)
+    return np.where(np.abs(f) > UNKNOWN_FLOW_THRESH, np.nan, f).astype(np.float32)

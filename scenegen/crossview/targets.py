@@ -1,0 +1,30 @@
+"""Calibration-target truth per view: each board point's world position, its exact projection
+through the view's full camera model, and its visibility (numpy; visibility by a passed function).
+
+``state`` uses :mod:`scenegen.crossview.correspondence`'s codes: VISIBLE (1), OCCLUDED (2,
+something in front, or the board seen from its back), OUT_OF_FRAME (3). ``facing`` is True when
+the camera is on the printed side (boards print on their -z side in the board frame).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen.crossview.correspondence import OCCLUDED, OUT_OF_FRAME, VISIBLE, in_frame, project_points
+
+
+def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn) -> dict:
+    """JSON-ready truth of one board in one view (see the module docstring)."""
+    P = world_from_board.apply(np.asarray(board.points_board, np.float64))
+    uv, z, valid = project_points(P, camera, cam_from_world)
+    inside = valid & in_frame(uv, camera)
+    C = cam_from_world.inverse().t
+    n_print = world_from_board.rotate(np.array([0.0, 0.0, -1.0]))  # print side normal, world
+    facing = (C - P) @ n_print > 0
+    state = np.full(len(P), OUT_OF_FRAME, np.int64)
+    cand = np.flatnonzero(inside)
+    vis = np.asarray(visible_fn(C, P[cand]), bool) & facing[cand]
+    state[cand] = np.where(vis, VISIBLE, OCCLUDED)
+    return {"kind": board.kind, "point_ids": np.asarray(board.point_ids).tolist(),
+            "points_world": P.tolist(),
+            "uv": [[float(a), float(b)] if np.isfinite(a) else None for a, b in uv],
+            "depth_z": [float(x) for x in z], "state": state.tolist(), "facing": facing.tolist()}
