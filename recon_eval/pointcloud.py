@@ -106,6 +106,20 @@ def tanks_and_temples(
     points_rec (N, 3), points_gt (M, 3) float64 metres; gt_mesh optional (vertices (V, 3), faces
     (F, 3)) for exact rec -> GT surface distances.
     """
+    d_rg, d_gr, voxel, to = tanks_and_temples_distances(points_rec, points_gt, tau_m, gt_mesh=gt_mesh,
+                                                        downsample=downsample)
+    if len(d_rg) == 0 or len(d_gr) == 0:
+        return TanksAndTemplesResult(tau_m, 0.0, 0.0, 0.0, len(d_rg), len(d_gr), voxel, to, alignment=alignment)
+    p = float(np.count_nonzero(d_rg < tau_m) / len(d_rg))
+    r = float(np.count_nonzero(d_gr < tau_m) / len(d_gr))
+    return TanksAndTemplesResult(tau_m, p, r, _fscore(p, r), len(d_rg), len(d_gr), voxel, to, alignment=alignment)
+
+
+def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=None, downsample: bool = True):
+    """The distances Tanks and Temples thresholds: ``(d_rec_to_gt (N,), d_gt_to_rec (M,), voxel_m,
+    distance_rec_to_gt)`` after voxel downsampling both clouds at tau/2 (``voxel_m`` None when not
+    downsampled). Its precision/recall curves over thresholds (the toolbox's plots) use these same
+    distances. An empty side gives empty arrays."""
     rec = _check_cloud(points_rec, "reconstructed points")
     gt = _check_cloud(points_gt, "GT points")
     if not tau_m > 0:
@@ -115,12 +129,10 @@ def tanks_and_temples(
         rec, gt = voxel_downsample(rec, voxel), voxel_downsample(gt, voxel)
     if len(rec) == 0 or len(gt) == 0:
         to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
-        return TanksAndTemplesResult(tau_m, 0.0, 0.0, 0.0, len(rec), len(gt), voxel, to.value, alignment=alignment)
+        return np.full(len(rec), np.inf), np.full(len(gt), np.inf), voxel, to.value
     d_rg, to = _rec_to_gt(rec, gt, gt_mesh)
     d_gr = nearest_point_distances(gt, rec)
-    p = float(np.mean(d_rg < tau_m))
-    r = float(np.mean(d_gr < tau_m))
-    return TanksAndTemplesResult(tau_m, p, r, _fscore(p, r), len(rec), len(gt), voxel, to.value, alignment=alignment)
+    return d_rg, d_gr, voxel, to.value
 
 
 # --- ETH3D -------------------------------------------------------------------------------------

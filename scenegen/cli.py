@@ -70,6 +70,15 @@ def cmd_info(args) -> int:
     return 0
 
 
+def cmd_export(args) -> int:
+    from scenegen.export import export
+
+    s = export(args.dataset, args.format, args.output)
+    extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
+    print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
+    return 0
+
+
 def cmd_verify(args) -> int:
     from scenegen.dataset import verify
 
@@ -105,6 +114,13 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("dataset", type=Path)
     f.add_argument("--json", action="store_true")
     f.set_defaults(fn=cmd_verify)
+    from scenegen.export import FORMATS
+
+    e = sub.add_parser("export", help="export a dataset to colmap, nerf, kitti-stereo, middlebury, opencv or tum")
+    e.add_argument("dataset", type=Path)
+    e.add_argument("--format", required=True, choices=tuple(FORMATS))
+    e.add_argument("-o", "--output", type=Path, help="destination folder (default: <dataset>.<format>)")
+    e.set_defaults(fn=cmd_export)
     return p
 
 

@@ -113,6 +113,10 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
     resolved["objects_ids"] = built.objects
+    from scenegen.imaging.stage import apply_imaging, imaging_record  # docs/image_formation.md
+
+    if (imaging := imaging_record(spec, views)) is not None:
+        resolved["imaging_used"] = imaging
     writer.write_cameras(view_cams, resolved)
     for name, mesh in built.meshes_world.items():
         writer.write_mesh(name, mesh)
@@ -129,8 +133,14 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                 continue
             linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index))
             truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables)
-            writer.write_view(v.name, image=encode_image(linear, rs.bit_depth), linear_rgb=linear,
-                              truth=_truth_for_storage(truth))
+            params = spec.cameras[v.camera].imaging
+            if params is None:  # clean path: sRGB encoding of the linear render
+                image, extra = encode_image(linear, rs.bit_depth), None
+            else:  # the camera's photometric chain; its vignetting map is saved as truth
+                image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed,
+                                             index, v.name)
+            writer.write_view(v.name, image=image, linear_rgb=linear,
+                              truth=_truth_for_storage(truth), extra_files=extra)
             rendered += 1
             bar.advance()
     from scenegen.crossview.stage import run_crossview  # cross-view truth (docs/crossview.md)

@@ -181,6 +181,39 @@ CASES = [
     ("bad_name_characters",
      "cameras:\n  my cam: {size: [64, 48], fx: 50}\n",
      2, "cameras.my cam", "expected a camera name made of letters, digits"),
+    # cameras.<name>.imaging (docs/image_formation.md)
+    ("imaging_unknown_preset_suggests",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {preset: smartfone}\n",
+     5, "cameras.cam.imaging.preset", "got 'smartfone' (did you mean 'smartphone'?)"),
+    ("imaging_unknown_key",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      exposure_s: 0.01\n",
+     6, "cameras.cam.imaging.exposure_s", "unknown key 'exposure_s'"),
+    ("imaging_negative_exposure_time",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      exposure:\n"
+     "        exposure_time_s: -0.01\n",
+     7, "cameras.cam.imaging.exposure.exposure_time_s", "expected a value > 0 (seconds)"),
+    ("imaging_qe_above_one",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      sensor:\n"
+     "        quantum_efficiency: [0.5, 1.2, 0.5]\n",
+     7, "cameras.cam.imaging.sensor.quantum_efficiency[1]", "expected a value >= 0 and <= 1"),
+    ("imaging_vignetting_coeffs_length",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n"
+     "      vignetting: {coeffs: [-0.3, 0.1]}\n",
+     6, "cameras.cam.imaging.vignetting.coeffs", "expected 3 numbers"),
+    ("imaging_bad_bayer_pattern",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {bayer: RGBG}\n",
+     5, "cameras.cam.imaging.bayer", "expected one of 'RGGB', 'BGGR', 'GRBG', 'GBRG', 'none'"),
+    ("imaging_adc_bits_too_many",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      sensor:\n"
+     "        adc_bits: 20\n",
+     7, "cameras.cam.imaging.sensor.adc_bits", "expected a value >= 1 and <= 16 (bits)"),
+    ("imaging_black_level_above_white",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: smartphone\n"
+     "      sensor:\n        black_level_dn: 1023\n",
+     8, "cameras.cam.imaging.sensor.black_level_dn", "expected black_level_dn < 2^adc_bits - 1"),
+    ("imaging_bad_white_balance",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {white_balance: daylight}\n",
+     5, "cameras.cam.imaging.white_balance", "expected one of 'auto'"),
 ]
 
 

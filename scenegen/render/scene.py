@@ -133,12 +133,14 @@ def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool):
     mm = mi.Mesh(name, len(mesh.vertices), len(mesh.faces), props=props,
                  has_vertex_normals=smooth, has_vertex_texcoords=uv is not None)
     params = mi.traverse(mm)
-    params["vertex_positions"] = mi.Float(np.asarray(mesh.vertices, np.float32).ravel())
-    params["faces"] = mi.UInt32(np.asarray(mesh.faces, np.uint32).ravel())
+    # the buffers' own types: Dr.Jit arrays in vectorised variants, dynamic arrays in scalar ones
+    put = lambda key, a, dtype: params.__setitem__(key, type(params[key])(np.asarray(a, dtype).ravel()))
+    put("vertex_positions", mesh.vertices, np.float32)
+    put("faces", mesh.faces, np.uint32)
     if smooth:
-        params["vertex_normals"] = mi.Float(np.asarray(mesh.vertex_normals, np.float32).ravel())
+        put("vertex_normals", mesh.vertex_normals, np.float32)
     if uv is not None:
-        params["vertex_texcoords"] = mi.Float(np.asarray(uv, np.float32).ravel())
+        put("vertex_texcoords", uv, np.float32)
     params.update()
     return mm
 

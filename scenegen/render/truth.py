@@ -52,6 +52,9 @@ def shape_id_table(scene, object_ids: dict, instance_ids: dict):
     Shapes not listed map to 0.
     """
     shapes = scene.shapes()
+    if mi.variant().startswith("scalar"):  # no shape pointers to gather from: look up by id
+        return ({s.id(): object_ids.get(s.id(), 0) for s in shapes},
+                {s.id(): instance_ids.get(s.id(), 0) for s in shapes})
     reg = [int(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(s))[0]) for s in shapes]
     size = max(reg, default=0) + 1
     obj = np.zeros(size, np.uint32)
@@ -70,6 +73,8 @@ def _matvec(R, v):
 
 def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict[str, np.ndarray]:
     """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring."""
+    if mi.variant().startswith("scalar"):
+        return _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
     H, W = camera.height, camera.width
     world_from_cam = cam_from_world.inverse()
     Rwc = [[dr.opaque(mi.Float64, float(world_from_cam.R[i, j])) for j in range(3)] for i in range(3)]
@@ -80,8 +85,7 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict
     d_world = _matvec(Rwc, d_cam)
     ray = mi.Ray3f(mi.Point3f(mi.Vector3f(C)), mi.Vector3f(d_world))
     # only what the outputs need: position, uv and the shading normal (no dP/dUV derivatives)
-    si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.Minimal | mi.RayFlags.UV | mi.RayFlags.ShadingFrame,
-                             coherent=True)
+    si = scene.ray_intersect(ray, ray_flags=_flags(), coherent=True)
     hit = si.is_valid()
     nan64 = dr.nan if hasattr(dr, "nan") else math.nan
     t = dr.select(hit, mi.Float64(si.t), dr.inf)
@@ -107,4 +111,54 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict
     # .numpy() of an evaluated flat array is a zero-copy view; vectors are stacked per component
     out = {k: np.stack([c.numpy() for c in v], axis=-1).reshape(H, W, len(v)) for k, v in vectors.items()}
     out.update({k: v.numpy().reshape(H, W) for k, v in scalars.items()})
+    return out
+
+
+def _flags():
+    """Only what the truth needs: position, uv and the shading normal (no dP/dUV derivatives)."""
+    return mi.RayFlags.Minimal | mi.RayFlags.UV | mi.RayFlags.ShadingFrame
+
+
+def _truth_pass_scalar(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict[str, np.ndarray]:
+    """The same truth in the ``scalar_rgb`` fallback (no working libLLVM): one Python call per
+    ray, derived in float64 numpy. Slow (seconds per VGA frame), for correctness only."""
+    H, W = camera.height, camera.width
+    world_from_cam = cam_from_world.inverse()
+    d_cam = camera_rays(camera)
+    d_world = d_cam @ world_from_cam.R.T
+    hits = _cast_rays_scalar(scene, world_from_cam.t[None], d_world, id_tables)
+    t, valid = hits["t"], hits["valid"]
+    t_pts = np.where(valid, t, np.nan)[:, None]
+    n_world = hits["normals_world"].astype(np.float64)
+    n_world /= np.linalg.norm(n_world, axis=1, keepdims=True)
+    out = {
+        "range": t, "depth_z": t * d_cam[:, 2],
+        "points_cam": (d_cam * t_pts).astype(np.float32),
+        "points_world": (world_from_cam.t + d_world * t_pts).astype(np.float32),
+        "normals_world": n_world.astype(np.float32),
+        "normals_cam": (n_world @ world_from_cam.R).astype(np.float32),
+        "uv": hits["uv"], "object_id": hits["object_id"], "instance_id": hits["instance_id"], "valid": valid,
+    }
+    return {k: v.reshape((H, W) + v.shape[1:]) for k, v in out.items()}
+
+
+def _cast_rays_scalar(scene, origins_world, dirs_world, id_tables) -> dict[str, np.ndarray]:
+    obj_by_id, inst_by_id = id_tables
+    n_rays = len(dirs_world)
+    out = {"t": np.full(n_rays, np.inf), "normals_world": np.full((n_rays, 3), np.nan, np.float32),
+           "uv": np.full((n_rays, 2), np.nan, np.float32), "object_id": np.zeros(n_rays, np.uint32),
+           "instance_id": np.zeros(n_rays, np.uint32), "valid": np.zeros(n_rays, bool)}
+    o = origins_world.astype(np.float32)
+    for i, d in enumerate(dirs_world.astype(np.float32)):
+        oi = o[0] if len(o) == 1 else o[i]
+        si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*oi.tolist()), mi.Vector3f(*d.tolist())), _flags(), True)
+        if not si.is_valid():
+            continue
+        sid = si.shape.id()
+        out["t"][i] = si.t
+        out["normals_world"][i] = list(si.sh_frame.n)
+        out["uv"][i] = list(si.uv)
+        out["object_id"][i] = obj_by_id.get(sid, 0)
+        out["instance_id"][i] = inst_by_id.get(sid, 0)
+        out["valid"][i] = True
     return out

@@ -1,0 +1,47 @@
+"""Exports of a dataset folder into other tools' formats, one module per format.
+
+``export(out_dir, fmt, dest)`` reads a dataset (``scenegen.dataset.Dataset``; its cross-view
+files where a format needs them) and writes ``dest`` (a new or empty folder). Nothing here
+imports Mitsuba. Formats (docs/crossview.md, "Exports"):
+
+* ``colmap``: COLMAP text model (cameras.txt, images.txt, points3D.txt) + images/;
+* ``nerf``: instant-ngp / nerfstudio ``transforms.json`` + images/;
+* ``kitti-stereo``: KITTI 2015 stereo layout from the rectified stereo frames;
+* ``middlebury``: Middlebury v3 folders (im0/im1.png, disp0/disp1.pfm, calib.txt);
+* ``opencv``: cv2.FileStorage YAML (K, D, R, T per view; K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q per
+  stereo frame; R T E F per cross-view pair);
+* ``tum``: TUM RGB-D trajectories, one file per camera stream.
+"""
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+FORMATS = {"colmap": "colmap", "nerf": "nerf", "kitti-stereo": "kitti_stereo",
+           "middlebury": "middlebury", "opencv": "opencv_yaml", "tum": "tum"}
+
+
+class ExportError(ValueError):
+    """The dataset cannot be exported in the requested format (message says why)."""
+
+
+def default_dest(out_dir, fmt: str) -> Path:
+    """``<OUT>.<format>`` next to the dataset (inside it, ``verify`` would flag the files)."""
+    p = Path(out_dir)
+    return p.parent / f"{p.name}.{fmt}"
+
+
+def export(out_dir, fmt: str, dest=None) -> dict:
+    """Export dataset ``out_dir`` as ``fmt`` into ``dest`` (default :func:`default_dest`);
+    returns a summary dict ``{"dest": ..., "files": n, ...}``."""
+    if fmt not in FORMATS:
+        raise ExportError(f"unknown export format {fmt!r}; choose one of {', '.join(FORMATS)}")
+    from scenegen.export._common import open_dataset, prepare_dest
+
+    ds = open_dataset(out_dir)
+    dest = Path(dest) if dest is not None else default_dest(out_dir, fmt)
+    prepare_dest(dest)
+    mod = importlib.import_module(f"scenegen.export.{FORMATS[fmt]}")
+    summary = mod.export(ds, dest)
+    summary["dest"] = str(dest)
+    return summary

@@ -1,0 +1,44 @@
+"""KITTI 2015 stereo layout from the rectified stereo frames (crossview/stereo/*).
+
+Frame k (in the run's order) becomes ``training/image_2/{k:06d}_10.png`` (left rectified,
+8-bit RGB), ``training/image_3/{k:06d}_10.png`` (right), ``training/disp_occ_0/{k:06d}_10.png``
+(left disparity on every pixel with a surface) and ``training/disp_noc_0/{k:06d}_10.png`` (only
+pixels visible in the right view), uint16 ``round(d * 256)`` with 0 = invalid, and
+``training/calib_cam_to_cam/{k:06d}.txt`` with ``S_rect_02/03``, ``R_rect_02/03`` (identity:
+the renders are already rectified) and ``P_rect_02/03`` (3x4 row-major; P_rect_03[0, 3] = -f B).
+``frames.json`` maps each index to our stereo folder and views.
+"""
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+
+from scenegen import io as sio
+from scenegen.export._common import stereo_frames, to_uint8, write
+
+
+def _row(M) -> str:
+    return " ".join(f"{x:.12e}" for x in np.asarray(M, float).ravel())
+
+
+def export(ds, dest) -> dict:
+    frames = stereo_frames(ds)
+    out = []
+    for k, fr in enumerate(frames):
+        base, tag = fr["dir"], f"{k:06d}"
+        for side, folder in (("left", "image_2"), ("right", "image_3")):
+            img = to_uint8(sio.read_png(ds.path(f"{base}/{side}.png")))
+            write(dest, f"training/{folder}/{tag}_10.png", sio.encode_png(img))
+        for kind in ("occ", "noc"):
+            (dest / f"training/disp_{kind}_0").mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(ds.path(f"{base}/disp_left_{kind}.png"), dest / f"training/disp_{kind}_0/{tag}_10.png")
+        calib = sio.read_json(ds.path(f"{base}/calib.json"))
+        W, H = calib["size"]
+        lines = [f"S_rect_02: {W:.6e} {H:.6e}", f"R_rect_02: {_row(np.eye(3))}", f"P_rect_02: {_row(calib['P1'])}",
+                 f"S_rect_03: {W:.6e} {H:.6e}", f"R_rect_03: {_row(np.eye(3))}", f"P_rect_03: {_row(calib['P2'])}"]
+        write(dest, f"training/calib_cam_to_cam/{tag}.txt", ("\n".join(lines) + "\n").encode())
+        out.append({"index": tag, "stereo_dir": base, "left_view": fr["left_view"], "right_view": fr["right_view"]})
+    write(dest, "frames.json", (json.dumps(out, indent=2) + "\n").encode())
+    return {"files": 6 * len(frames) + 1, "frames": len(frames)}

@@ -1,0 +1,89 @@
+"""OpenCV FileStorage YAML (written by cv2.FileStorage itself, read by any OpenCV).
+
+* ``cameras.yaml``: ``views``, a sequence of maps {name, image_size [W, H], K, D (OpenCV's
+  distortion vector for cv2.projectPoints / cv2.fisheye), model, R, T (cam_from_world:
+  x_cam = R x_world + T)}.
+* ``stereo/<left_view>.yaml`` per rectified stereo frame, as cv2.stereoCalibrate +
+  cv2.stereoRectify would give: K1, D1, K2, D2, image_size, R, T (right_from_left), E, F (on
+  undistorted pixels, x_r^T F x_l = 0, scaled to F[2, 2] = 1 as OpenCV does), R1, R2, P1, P2, Q.
+* ``pairs.yaml``: ``pairs``, a sequence of {i, j, R, T (j_from_i), E, F} for every cross-view
+  pair of the dataset (present when the dataset has cross-view truth).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen import io as sio
+from scenegen.crossview.twoview import TwoView
+from scenegen.export._common import write
+
+
+def _fs():
+    import cv2
+
+    return cv2.FileStorage("out.yaml", cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_MEMORY | cv2.FILE_STORAGE_FORMAT_YAML)
+
+
+def _F_opencv(F):
+    F = np.asarray(F, float)
+    return F / F[2, 2] if abs(F[2, 2]) > 1e-12 * np.linalg.norm(F) else F
+
+
+def export(ds, dest) -> dict:
+    import cv2
+
+    fs = _fs()
+    fs.startWriteStruct("views", cv2.FILE_NODE_SEQ)
+    for v in ds.views:
+        cam, pose = ds.camera(v)
+        K, D = cam.to_opencv()
+        fs.startWriteStruct("", cv2.FILE_NODE_MAP)
+        fs.write("name", v)
+        fs.write("model", cam.model)
+        fs.write("image_size", np.array([cam.width, cam.height], np.int32))
+        fs.write("K", K)
+        fs.write("D", D.reshape(1, -1))
+        fs.write("R", pose.R)
+        fs.write("T", pose.t.reshape(3, 1))
+        fs.endWriteStruct()
+    fs.endWriteStruct()
+    write(dest, "cameras.yaml", fs.releaseAndGetString().encode())
+    n = 1
+    index_p = ds.path("crossview/index.json")
+    if index_p.is_file():
+        index = sio.read_json(index_p)
+        for fr in index["stereo"]:
+            calib = sio.read_json(ds.path(f"{fr['dir']}/calib.json"))
+            from scenegen.camera import Camera
+            from scenegen.pose import Rigid3
+
+            cl, cr = Camera.from_dict(calib["raw_left"]["camera"]), Camera.from_dict(calib["raw_right"]["camera"])
+            pl, pr = Rigid3.from_dict(calib["raw_left"]["cam_from_world"]), Rigid3.from_dict(calib["raw_right"]["cam_from_world"])
+            tv = TwoView.of(cl, pl, cr, pr)
+            fs = _fs()
+            (K1, D1), (K2, D2) = cl.to_opencv(), cr.to_opencv()
+            for key, val in (("K1", K1), ("D1", D1.reshape(1, -1)), ("K2", K2), ("D2", D2.reshape(1, -1)),
+                             ("image_size", np.array([cl.width, cl.height], np.int32)),
+                             ("R", tv.j_from_i.R), ("T", tv.j_from_i.t.reshape(3, 1)), ("E", tv.E),
+                             ("F", _F_opencv(tv.F)), ("R1", np.array(calib["R1"])), ("R2", np.array(calib["R2"])),
+                             ("P1", np.array(calib["P1"])), ("P2", np.array(calib["P2"])), ("Q", np.array(calib["Q"]))):
+                fs.write(key, val)
+            write(dest, f"stereo/{fr['left_view']}.yaml", fs.releaseAndGetString().encode())
+            n += 1
+        if index["pairs"]:
+            fs = _fs()
+            fs.startWriteStruct("pairs", cv2.FILE_NODE_SEQ)
+            for p in index["pairs"]:
+                tv = sio.read_json(ds.path(f"crossview/twoview/{p['i']}/{p['j']}.json"))
+                fs.startWriteStruct("", cv2.FILE_NODE_MAP)
+                fs.write("i", p["i"])
+                fs.write("j", p["j"])
+                fs.write("R", np.array(tv["j_from_i"]["R"]))
+                fs.write("T", np.array(tv["j_from_i"]["t"]).reshape(3, 1))
+                fs.write("E", np.array(tv["E"]))
+                fs.write("F", _F_opencv(tv["F"]))
+                fs.endWriteStruct()
+            fs.endWriteStruct()
+            write(dest, "pairs.yaml", fs.releaseAndGetString().encode())
+            n += 1
+    return {"files": n}
