@@ -224,11 +224,9 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     for name, cam_spec in spec.cameras.items():
         cam = cam_spec.to_camera()
         built.cameras[name] = cam
-        d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler)
+        d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler, name=name)
     built.scene = mi.load_dict(d)
-    by_id = {s.id(): s for s in built.scene.sensors()}
-    for name, cam in built.cameras.items():
-        built.sensors[name] = by_id[f"sensor_{name}"]
+    built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
     return built
 

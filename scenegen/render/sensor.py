@@ -30,6 +30,8 @@ class ScenegenSensor(mi.Sensor):
 
     def __init__(self, props):
         mi.Sensor.__init__(self, props)
+        # Mitsuba gives Python sensors of one scene the same id(): keep our own name
+        self.camera_name = props.get("camera_name", "") if props.has_property("camera_name") else ""
         self.model = "pinhole"
         self.iterations = 0
         self.p = None
@@ -88,13 +90,14 @@ def register() -> None:
 
 
 def sensor_dict(camera: Camera, *, spp: int, sampler: str = "ldsampler", seed: int = 0,
-                pixel_format: str = "rgb") -> dict:
+                pixel_format: str = "rgb", name: str = "") -> dict:
     """Mitsuba dict for our sensor with a float32 box-filtered film of the camera's size.
 
     The box filter keeps renders bitwise deterministic and pixel values unblurred across pixels.
     """
     return {
         "type": SENSOR_PLUGIN,
+        "camera_name": name,
         "film": {"type": "hdrfilm", "width": camera.width, "height": camera.height,
                  "rfilter": {"type": "box"}, "pixel_format": pixel_format, "component_format": "float32"},
         "sampler": {"type": sampler, "sample_count": int(spp), "seed": int(seed)},

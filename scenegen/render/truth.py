@@ -101,7 +101,7 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict
     sid = dr.select(hit, sid, 0)
     obj = dr.select(hit, dr.gather(mi.UInt32, obj_table, sid), 0)
     inst = dr.select(hit, dr.gather(mi.UInt32, inst_table, sid), 0)
-    depth_z = t * d_cam.z
+    depth_z = dr.select(hit, t * d_cam.z, dr.inf)  # t * z is -inf or NaN for misses of rays at or beyond 90 degrees
     # vectors are rounded once to float32 (the stored precision) inside the kernel; range and
     # depth_z stay float64, so float64 points are C + range * ray when a caller needs them
     vectors = {"points_cam": mi.Vector3f(points_cam), "points_world": mi.Vector3f(points_world),

@@ -1,0 +1,136 @@
+"""The HTML report: one self-contained, valid HTML file with the numbers and embedded PNG figures."""
+import base64
+import re
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+
+from recon_eval.cli import main
+
+pytest.importorskip("matplotlib")
+
+VOID = {"meta", "img", "br", "hr", "link", "input"}
+
+
+class _Checker(HTMLParser):
+    """Collects tags, checks nesting of non-void elements, collects image sources and text."""
+
+    def __init__(self):
+        super().__init__()
+        self.stack, self.errors, self.imgs, self.text, self.tags = [], [], [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        if tag == "img":
+            self.imgs.append(dict(attrs)["src"])
+        elif tag not in VOID:
+            self.stack.append(tag)
+
+    def handle_endtag(self, tag):
+        if not self.stack or self.stack.pop() != tag:
+            self.errors.append(f"unbalanced </{tag}>")
+
+    def handle_data(self, data):
+        self.text.append(data)
+
+
+def check_html(path):
+    """Parse; return (checker, decoded PNG images). Fails on broken structure or external refs."""
+    import cv2
+
+    s = path.read_text(encoding="utf-8")
+    assert s.startswith("<!DOCTYPE html>")
+    c = _Checker()
+    c.feed(s)
+    c.close()
+    assert not c.errors and not c.stack, (c.errors, c.stack)
+    assert {"html", "head", "body", "title", "table"} <= set(c.tags)
+    assert not re.search(r'(src|href)="(?!data:)', s)  # self-contained: no external resources
+    pngs = []
+    for src in c.imgs:
+        assert src.startswith("data:image/png;base64,")
+        raw = base64.b64decode(src.split(",", 1)[1], validate=True)
+        assert raw[:8] == b"\x89PNG\r\n\x1a\n"
+        img = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_UNCHANGED)
+        assert img is not None and img.shape[0] > 100 and img.shape[1] > 100
+        pngs.append(raw)
+    return c, pngs
+
+
+def test_depth_report_has_heatmaps_and_numbers(plane_dataset, tmp_path, capsys):
+    from recon_eval.readers.scenegen_dataset import read_dataset
+
+    root, _ = plane_dataset
+    ds = read_dataset(root)
+    (tmp_path / "est").mkdir()
+    e = ds.depth("left_000") * 1.1
+    e[:5, :5] = np.nan
+    np.save(tmp_path / "est" / "left_000.npy", e)
+    assert main(["depth", str(tmp_path / "est"), str(root), "--view", "left_000", "--quiet",
+                 "--html", str(tmp_path / "r.html")]) == 0
+    c, pngs = check_html(tmp_path / "r.html")
+    text = " ".join(c.text)
+    assert len(pngs) == 2 and "Depth error: left_000" in text and "Cumulative relative depth error" in text
+    assert "abs_rel" in text and "0.1" in text  # the number itself, from the table
+
+    from recon_eval.readers.pfm import write_pfm
+
+    d = ds.disparity("left_000") + rng_noise((30, 40))
+    write_pfm(tmp_path / "d.pfm", d)
+    assert main(["disparity", str(tmp_path / "d.pfm"), str(root), "--view", "left_000", "--quiet",
+                 "--html", str(tmp_path / "d.html")]) == 0
+    c, pngs = check_html(tmp_path / "d.html")
+    assert len(pngs) == 2 and "d1_all_occ_pct" in " ".join(c.text)
+
+
+def rng_noise(shape):
+    return np.random.default_rng(0).normal(0, 1.0, shape)
+
+
+def test_poses_cloud_fmatrix_calibration_reports(plane_dataset, tmp_path, capsys):
+    from recon_eval.epipolar import fundamental_from_pose
+    from recon_eval.readers.nerf import write_nerf_transforms
+    from recon_eval.readers.opencv_calib import write_opencv_calibration
+    from recon_eval.readers.ply import write_point_cloud_ply
+    from recon_eval.readers.scenegen_dataset import read_dataset
+
+    root, cams = plane_dataset
+    write_nerf_transforms(tmp_path / "t.json", read_dataset(root).poses)
+    assert main(["poses", str(tmp_path / "t.json"), str(root), "--alignment", "none", "--quiet",
+                 "--html", str(tmp_path / "p.html")]) == 0
+    c, pngs = check_html(tmp_path / "p.html")
+    assert len(pngs) == 4 and "Per-camera pose errors" in " ".join(c.text)
+
+    rng = np.random.default_rng(1)
+    write_point_cloud_ply(tmp_path / "rec.ply", np.c_[rng.uniform(-2, 2, (2000, 2)), rng.normal(0, 0.003, 2000)])
+    assert main(["cloud", str(tmp_path / "rec.ply"), str(root), "--tau", "0.005", "--gt-samples", "20000", "--quiet",
+                 "--html", str(tmp_path / "c.html")]) == 0
+    c, pngs = check_html(tmp_path / "c.html")
+    assert len(pngs) == 2 and "Precision / recall / F-score vs tau" in " ".join(c.text)
+
+    (c1, p1), (c2, p2) = cams["left_000"], cams["right_000"]
+    rel = p2 @ p1.inverse()
+    F = fundamental_from_pose(c1.K, c2.K, rel.R, rel.t) + 1e-4
+    np.savetxt(tmp_path / "F.txt", F)
+    assert main(["fmatrix", str(tmp_path / "F.txt"), "--dataset", str(root), "--views", "left_000", "right_000",
+                 "--quiet", "--html", str(tmp_path / "f.html")]) == 0
+    c, pngs = check_html(tmp_path / "f.html")
+    assert len(pngs) == 2 and "Epipolar lines" in " ".join(c.text) and "sampson_rms_px" in " ".join(c.text)
+    (tmp_path / "epipolar.png").write_bytes(pngs[1])
+
+    write_opencv_calibration(tmp_path / "k.yaml", cams["free_000"][0].__class__(
+        "opencv", 40, 30, 42.5, 41.0, 19.0, 15.0, 0.0, (-0.04, 0.01, 0.001, -0.001, 0.0)))
+    assert main(["calibration", str(tmp_path / "k.yaml"), str(root), "--view", "free_000", "--quiet",
+                 "--html", str(tmp_path / "k.html")]) == 0
+    c, pngs = check_html(tmp_path / "k.html")
+    assert len(pngs) == 2 and "fx_abs_err_px" in " ".join(c.text) and "0.5" in " ".join(c.text)
+
+
+def test_no_matplotlib_at_import():
+    import subprocess
+    import sys
+
+    code = ("import sys, recon_eval.cli, recon_eval.html_report\n"
+            "assert 'matplotlib' not in sys.modules, 'matplotlib imported eagerly'\n")
+    subprocess.run([sys.executable, "-c", code], check=True)
