@@ -35,7 +35,7 @@ def _imshow(ax, img, title, cmap="viridis", vmin=None, vmax=None, label=None):
     import matplotlib
 
     cm = matplotlib.colormaps[cmap].copy()
-    cm.set_bad(MISSING_GREY)
+    cm = cm.with_extremes(bad=MISSING_GREY)
     a = np.ma.masked_invalid(np.asarray(img, dtype=np.float64))
     h, w = a.shape
     im = ax.imshow(a, cmap=cm, vmin=vmin, vmax=vmax, interpolation="nearest", extent=(-0.5, w - 0.5, h - 0.5, -0.5))
@@ -215,7 +215,7 @@ def field_figure(field, grid_u, grid_v, *, title: str, unit: str) -> bytes:
     import matplotlib
 
     cm = matplotlib.colormaps["inferno"].copy()
-    cm.set_bad(MISSING_GREY)
+    cm = cm.with_extremes(bad=MISSING_GREY)
     U, V = np.meshgrid(grid_u, grid_v)
     pc = ax.pcolormesh(U, V, np.ma.masked_invalid(f), cmap=cm, shading="nearest")
     if np.isfinite(f).sum() > 4 and np.nanmax(f) > np.nanmin(f):

@@ -31,7 +31,7 @@ class ScenegenSensor(mi.Sensor):
     def __init__(self, props):
         mi.Sensor.__init__(self, props)
         # Mitsuba gives Python sensors of one scene the same id(): keep our own name
-        self.camera_name = props.get("camera_name", "") if props.has_property("camera_name") else ""
+        self.camera_name = props["camera_name"] if "camera_name" in props else ""
         self.model = "pinhole"
         self.iterations = 0
         self.p = None

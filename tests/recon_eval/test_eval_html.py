@@ -111,7 +111,10 @@ def test_poses_cloud_fmatrix_calibration_reports(plane_dataset, tmp_path, capsys
 
     (c1, p1), (c2, p2) = cams["left_000"], cams["right_000"]
     rel = p2 @ p1.inverse()
-    F = fundamental_from_pose(c1.K, c2.K, rel.R, rel.t) + 1e-4
+    from scipy.spatial.transform import Rotation
+
+    dR = Rotation.from_rotvec([0.0, 0.0, 0.02]).as_matrix()  # a wrong but rank-2 F
+    F = fundamental_from_pose(c1.K, c2.K, dR @ rel.R, rel.t)
     np.savetxt(tmp_path / "F.txt", F)
     assert main(["fmatrix", str(tmp_path / "F.txt"), "--dataset", str(root), "--views", "left_000", "right_000",
                  "--quiet", "--html", str(tmp_path / "f.html")]) == 0
