@@ -107,7 +107,8 @@ def tanks_and_temples(
     (F, 3)) for exact rec -> GT surface distances.
     """
     d_rg, d_gr, voxel, to = tanks_and_temples_distances(points_rec, points_gt, tau_m, gt_mesh=gt_mesh,
-                                                        downsample=downsample)
+                                                        downsample=downsample,
+                                                        upper_bound_m=tau_m * (1.0 + _BOUND_SLACK))
     if len(d_rg) == 0 or len(d_gr) == 0:
         return TanksAndTemplesResult(tau_m, 0.0, 0.0, 0.0, len(d_rg), len(d_gr), voxel, to, alignment=alignment)
     p = float(np.count_nonzero(d_rg < tau_m) / len(d_rg))
@@ -115,11 +116,19 @@ def tanks_and_temples(
     return TanksAndTemplesResult(tau_m, p, r, _fscore(p, r), len(d_rg), len(d_gr), voxel, to, alignment=alignment)
 
 
-def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=None, downsample: bool = True):
+#: Relative slack of the search bound used for thresholded nearest-point distances: the bound
+#: tau (1 + 1e-6) lies far above float64 rounding of tau, so every distance below tau is exact and
+#: ``d < tau`` is decided exactly as without a bound.
+_BOUND_SLACK = 1e-6
+
+
+def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=None, downsample: bool = True,
+                                upper_bound_m: float = np.inf):
     """The distances Tanks and Temples thresholds: ``(d_rec_to_gt (N,), d_gt_to_rec (M,), voxel_m,
     distance_rec_to_gt)`` after voxel downsampling both clouds at tau/2 (``voxel_m`` None when not
     downsampled). Its precision/recall curves over thresholds (the toolbox's plots) use these same
-    distances. An empty side gives empty arrays."""
+    distances. An empty side gives empty arrays (of inf). Nearest-point distances at or beyond
+    ``upper_bound_m`` may be inf (see :func:`recon_eval.distances.nearest_point_distances`)."""
     rec = _check_cloud(points_rec, "reconstructed points")
     gt = _check_cloud(points_gt, "GT points")
     if not tau_m > 0:
@@ -130,8 +139,11 @@ def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=
     if len(rec) == 0 or len(gt) == 0:
         to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
         return np.full(len(rec), np.inf), np.full(len(gt), np.inf), voxel, to.value
-    d_rg, to = _rec_to_gt(rec, gt, gt_mesh)
-    d_gr = nearest_point_distances(gt, rec)
+    if gt_mesh is not None:
+        d_rg, to = mesh_surface_distances(rec, *gt_mesh), DistanceTo.MESH
+    else:
+        d_rg, to = nearest_point_distances(rec, gt, upper_bound_m=upper_bound_m), DistanceTo.POINTS
+    d_gr = nearest_point_distances(gt, rec, upper_bound_m=upper_bound_m)
     return d_rg, d_gr, voxel, to.value
 
 

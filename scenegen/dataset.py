@@ -153,13 +153,17 @@ class ViewCamera:
     rig: str | None = None  # rig name, None for a free camera
     rig_member: str | None = None  # member name inside the rig
     frame_index: int = 0  # index of the frame (rig pose) this view belongs to
+    optics: Mapping[str, Any] | None = None  # lens, shutter, chromatic aberration, camera motion
 
     def to_dict(self) -> dict:
         cam = self.camera.to_dict() if hasattr(self.camera, "to_dict") else dict(self.camera)
         pose = self.cam_from_world
         pose = pose.to_dict() if isinstance(pose, Rigid3) else Rigid3.from_dict(pose).to_dict()
-        return {"camera": cam, "cam_from_world": pose, "camera_name": self.camera_name,
-                "rig": self.rig, "rig_member": self.rig_member, "frame_index": int(self.frame_index)}
+        d = {"camera": cam, "cam_from_world": pose, "camera_name": self.camera_name,
+             "rig": self.rig, "rig_member": self.rig_member, "frame_index": int(self.frame_index)}
+        if self.optics:
+            d["optics"] = dict(self.optics)
+        return d
 
 
 # --- truth ------------------------------------------------------------------------------------

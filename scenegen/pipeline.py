@@ -108,7 +108,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                               versions=ds.software_versions(), resume=resume)
     view_cams = {v.name: ds.ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
-                                       frame_index=v.frame_index)
+                                       frame_index=v.frame_index, optics=view_optics(built, v))
                  for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
@@ -131,8 +131,10 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
             if writer.is_complete(v.name):
                 bar.advance()
                 continue
-            linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index))
-            truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables)
+            linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index),
+                                 motion=v.motion)
+            truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables,
+                               row_poses=rolling_shutter_rows(built, v))
             params = spec.cameras[v.camera].imaging
             if params is None:  # clean path: sRGB encoding of the linear render
                 image, extra = encode_image(linear, rs.bit_depth), None
@@ -149,6 +151,31 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                   spp=spp, seed=seed)
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)
+
+
+def rolling_shutter_rows(built, view):
+    """Per-row ``cam_from_world`` for a moving camera with a rolling shutter, else None."""
+    from scenegen.optics import row_poses
+
+    shutter = getattr(built.optics.get(view.camera), "shutter", None)
+    if shutter is None or shutter.rolling_readout_s == 0 or view.motion is None or view.motion.is_static:
+        return None
+    return row_poses(view.cam_from_world, view.motion, shutter, built.cameras[view.camera].height)
+
+
+def view_optics(built, view) -> dict | None:
+    """What cameras.json records of a view's lens and time effects (None if it has none)."""
+    from scenegen.optics import motion_to_dict
+
+    optics = built.optics.get(view.camera)
+    d = optics.to_dict() if optics is not None else {}
+    if view.motion is not None and not view.motion.is_static:
+        d["camera_motion"] = {**motion_to_dict(view.motion), "frame": "camera (OpenCV axes), body velocities; "
+                              "world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau], tau from mid-exposure"}
+    ca = getattr(optics, "chromatic_aberration", None)
+    if ca is not None:
+        d["channel_cameras"] = {c: cam.to_dict() for c, cam in zip("RGB", ca.channel_cameras(built.cameras[view.camera]))}
+    return d or None
 
 
 def board_truth(board, world_from_board) -> dict:

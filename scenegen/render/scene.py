@@ -36,7 +36,22 @@ class BuiltScene:
     meshes_world: dict  # object name -> trimesh.Trimesh in the world frame (for export)
     id_tables: tuple  # (object id table, instance id table) for the truth pass
     boards: dict = field(default_factory=dict)  # object name -> (targets.Board, world_from_board)
+    optics: dict = field(default_factory=dict)  # camera name -> scenegen.optics.Optics (or None)
+    moving: list = field(default_factory=list)  # objects that move during the exposure (_Moving)
+    motion_subframes: int = 1
     objects: list = field(default_factory=list)  # [{name, object_id, instance_id, kind}] for cameras.json
+
+
+@dataclass
+class _Moving:
+    """An object that moves over the exposure: its Mitsuba parameter keys and mid-exposure state."""
+
+    key: str  # the object's key in the scene dict
+    motion: object  # scenegen.optics.Motion (world frame, about the object origin)
+    world_from_object: Rigid3  # mid-exposure placement
+    sphere_to_world: np.ndarray | None = None  # (4, 4) for an analytic sphere
+    vertices: np.ndarray | None = None  # (V, 3) float64 world vertices at mid-exposure
+    normals: np.ndarray | None = None  # (V, 3) vertex normals, or None (flat shading)
 
 
 def _rgb(c) -> dict:
@@ -215,25 +230,89 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     for obj in spec.objects:
         key = f"obj_{obj.object_id:04d}"
         d[key] = object_entry(obj, built)
+        if obj.motion is not None and not obj.motion.is_static:
+            built.moving.append(_moving_entry(key, obj, d[key], built.meshes_world[obj.name]))
         object_ids[key] = obj.object_id
         instance_ids[key] = obj.instance_id
         built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
                               "kind": type(obj.geometry).__name__.lower()})
     for i, light in enumerate(spec.lights):
         d[f"light_{i:04d}"] = light_entry(light)
+    built.motion_subframes = spec.render.motion_subframes if built.moving else 1
     for name, cam_spec in spec.cameras.items():
         cam = cam_spec.to_camera()
         built.cameras[name] = cam
-        d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler, name=name)
+        built.optics[name] = cam_spec.optics
+        shutter = getattr(cam_spec.optics, "shutter", None)
+        timed = shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
+        d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler, name=name, timed=timed)
     built.scene = mi.load_dict(d)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
     return built
 
 
-def render_view(built: BuiltScene, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int) -> np.ndarray:
-    """Linear float32 (H, W, 3) radiance of one view."""
+def _moving_entry(key: str, obj: m.SceneObject, entry, mesh_world) -> _Moving:
+    if isinstance(entry, dict):  # the analytic sphere
+        return _Moving(key, obj.motion, obj.transform.world_from_object,
+                       sphere_to_world=np.array(entry["to_world"].matrix, dtype=np.float64))
+    normals = None
+    if entry.has_vertex_normals():
+        normals = np.asarray(mesh_world.vertex_normals, dtype=np.float64)
+    return _Moving(key, obj.motion, obj.transform.world_from_object,
+                   vertices=np.asarray(mesh_world.vertices, dtype=np.float64), normals=normals)
+
+
+def place_moving_objects(built: BuiltScene, tau_s: float) -> None:
+    """Move every moving object to its pose ``tau_s`` seconds after mid-exposure."""
+    if not built.moving:
+        return
+    from scenegen.optics import world_from_object_at
+
+    params = mi.traverse(built.scene)
+    for mv in built.moving:
+        # world_from_object(tau) @ object_from_world(mid): maps mid-exposure world points
+        move = world_from_object_at(mv.world_from_object, mv.motion, tau_s) @ mv.world_from_object.inverse()
+        if mv.sphere_to_world is not None:
+            params[f"{mv.key}.to_world"] = mi.ScalarTransform4f(move.matrix @ mv.sphere_to_world)
+            continue
+        put = lambda k, a: params.__setitem__(k, type(params[k])(np.asarray(a, np.float32).ravel()))
+        put(f"{mv.key}.vertex_positions", move.apply(mv.vertices))
+        if mv.normals is not None:
+            put(f"{mv.key}.vertex_normals", move.rotate(mv.normals))
+    params.update()
+
+
+def render_view(built: BuiltScene, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int,
+                motion=None) -> np.ndarray:
+    """Linear float32 (H, W, 3) radiance of one view, with the camera's lens and time effects.
+
+    ``cam_from_world`` is the mid-exposure pose; ``motion`` the camera's own velocities. Moving
+    objects are rendered in ``built.motion_subframes`` sub-frames (each a slice of the shutter
+    interval, with spp / sub-frames samples) and averaged; they are left at mid-exposure, where
+    the truth is cast. Chromatic aberration renders each colour channel with its own camera.
+    """
+    camera = built.cameras[camera_name]
+    optics = built.optics.get(camera_name)
     sensor = built.sensors[camera_name]
-    sensor.set_camera(built.cameras[camera_name], cam_from_world)
-    img = mi.render(built.scene, sensor=sensor, spp=int(spp), seed=int(seed))
-    return np.array(img, dtype=np.float32)[..., :3]
+    ca = getattr(optics, "chromatic_aberration", None)
+    channel_cameras = ca.channel_cameras(camera) if ca is not None else (camera,)
+    shutter = getattr(optics, "shutter", None)
+    exposure = 0.0 if shutter is None else shutter.exposure_s
+    n_sub = built.motion_subframes if exposure > 0 else 1
+    sub_spp = max(1, int(spp) // n_sub)
+    out = np.zeros((camera.height, camera.width, 3), np.float64)
+    for k in range(n_sub):
+        if n_sub > 1:
+            place_moving_objects(built, ((k + 0.5) / n_sub - 0.5) * exposure)
+        for c, cam in enumerate(channel_cameras):
+            sensor.set_camera(cam, cam_from_world, optics, motion, time_window=(k / n_sub, (k + 1) / n_sub))
+            img = np.array(mi.render(built.scene, sensor=sensor, spp=sub_spp, seed=(int(seed) + k) % 2**32),
+                           dtype=np.float32)[..., :3]
+            if len(channel_cameras) == 3:
+                out[..., c] += img[..., c]
+            else:
+                out += img
+    if n_sub > 1:
+        place_moving_objects(built, 0.0)
+    return (out / n_sub).astype(np.float32)

@@ -32,14 +32,25 @@ class ScenegenSensor(mi.Sensor):
         mi.Sensor.__init__(self, props)
         # Mitsuba gives Python sensors of one scene the same id(): keep our own name
         self.camera_name = props["camera_name"] if "camera_name" in props else ""
+        self.m_needs_sample_3 = True  # the aperture sample of the thin lens
         self.model = "pinhole"
         self.iterations = 0
         self.p = None
         self.R_world_from_cam = None
         self.center_world = None
+        self.height = 1
+        self.lens = None  # (aperture radius m, focus distance m), opaque
+        self.time_model = None  # see set_camera
 
-    def set_camera(self, camera: Camera, cam_from_world: Rigid3) -> None:
-        """Use ``camera`` at pose ``cam_from_world``; the film must already have its size."""
+    def set_camera(self, camera: Camera, cam_from_world: Rigid3, optics=None, motion=None,
+                   time_window=(0.0, 1.0)) -> None:
+        """Use ``camera`` at pose ``cam_from_world`` (the mid-exposure pose).
+
+        ``optics`` (:class:`scenegen.optics.Optics`) adds a thin lens and a shutter; ``motion``
+        (:class:`scenegen.optics.Motion`, camera-frame velocities) moves the camera over the
+        exposure. ``time_window`` is the part of the exposure this render covers (sub-frames).
+        The film must already have the camera's size.
+        """
         film_size = tuple(int(s) for s in self.film().size())
         if film_size != camera.size:
             raise ValueError(f"film is {film_size[0]}x{film_size[1]} but the camera is {camera.width}x{camera.height}")
@@ -49,27 +60,68 @@ class ScenegenSensor(mi.Sensor):
         self.p = SimpleNamespace(**{k: opaque(getattr(p, k)) for k in fields})
         self.model = camera.model
         self.iterations = camera.undistort_iterations
+        self.height = camera.height
         world_from_cam = cam_from_world.inverse()
         self.R_world_from_cam = [[opaque(world_from_cam.R[i, j]) for j in range(3)] for i in range(3)]
         self.center_world = [opaque(c) for c in world_from_cam.t]
+        lens = getattr(optics, "lens", None)
+        self.lens = None if lens is None else (opaque(lens.aperture_radius_m(camera)), opaque(lens.focus_distance_m))
+        shutter = getattr(optics, "shutter", None)
+        exposure = 0.0 if shutter is None else shutter.exposure_s
+        readout = 0.0 if shutter is None else shutter.rolling_readout_s
+        moving = motion is not None and not motion.is_static and (exposure > 0 or readout > 0)
+        if moving:
+            w = motion.angular_velocity_rad_s
+            speed = float(np.linalg.norm(w))
+            axis = w / speed if speed > 0 else np.zeros(3)
+            self.time_model = SimpleNamespace(
+                t0=opaque(time_window[0]), t1=opaque(time_window[1]), exposure=opaque(exposure),
+                readout=opaque(readout), speed=opaque(speed), rotating=speed > 0,
+                axis=[opaque(a) for a in axis], v=[opaque(c) for c in motion.linear_velocity_mps])
+        else:
+            self.time_model = None
 
-    def camera_rays(self, sample2):
-        """Unit ray directions in the world for film samples (Point2f in [0, 1]^2 of the crop)."""
+    def camera_frame_rays(self, sample2, sample3, time):
+        """(origins, unit directions) in the OpenCV camera frame at mid-exposure pose.
+
+        The chief ray comes from our camera model; a thin lens moves the origin over the aperture
+        and aims at the chief ray's point on the focus plane (depth z = focus distance); camera
+        motion turns and shifts the ray by the pose change at the sample's time.
+        """
         size = self.film().crop_size()
         offset = self.film().crop_offset()
         u, v = opencv_pixel_from_film(sample2, size, offset)
         dx, dy, dz = unproject_uv(u, v, self.p, self.model, self.iterations)
-        R = self.R_world_from_cam
-        d = mi.Vector3f(R[0][0] * dx + R[0][1] * dy + R[0][2] * dz,
-                        R[1][0] * dx + R[1][1] * dy + R[1][2] * dz,
-                        R[2][0] * dx + R[2][1] * dy + R[2][2] * dz)
-        return d
+        o = mi.Vector3f(0.0)
+        d = mi.Vector3f(dx, dy, dz)
+        if self.lens is not None:
+            radius, focus = self.lens
+            a = mi.warp.square_to_uniform_disk_concentric(sample3) * radius
+            o = mi.Vector3f(a.x, a.y, 0.0)
+            d = dr.normalize(d * (focus / dz) - o)
+        tm = self.time_model
+        if tm is not None:
+            # seconds from mid-exposure: position in the (sub-frame) window, plus the row's offset
+            tau = (tm.t0 + time * (tm.t1 - tm.t0) - 0.5) * tm.exposure
+            tau = tau + tm.readout * (v / max(self.height - 1, 1) - 0.5)
+            if tm.rotating:  # Rodrigues: world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau]
+                k = mi.Vector3f(*tm.axis)
+                ang = tm.speed * tau
+                c, s = dr.cos(ang), dr.sin(ang)
+                rot = lambda x: x * c + dr.cross(k, x) * s + k * dr.dot(k, x) * (1.0 - c)
+                o, d = rot(o), rot(d)
+            o = o + mi.Vector3f(*tm.v) * tau
+        return o, d
 
     def sample_ray(self, time, sample1, sample2, sample3, active=True):
         wavelengths, wav_weight = self.sample_wavelengths(dr.zeros(mi.SurfaceInteraction3f), sample1, active)
-        d = self.camera_rays(sample2)
-        o = mi.Point3f(*self.center_world)
-        return mi.Ray3f(o, d, time, wavelengths), wav_weight
+        o, d = self.camera_frame_rays(sample2, sample3, time)
+        R, C = self.R_world_from_cam, self.center_world
+        rot = lambda x: mi.Vector3f(R[0][0] * x.x + R[0][1] * x.y + R[0][2] * x.z,
+                                    R[1][0] * x.x + R[1][1] * x.y + R[1][2] * x.z,
+                                    R[2][0] * x.x + R[2][1] * x.y + R[2][2] * x.z)
+        origin = mi.Point3f(rot(o) + mi.Vector3f(*C))
+        return mi.Ray3f(origin, rot(d), time, wavelengths), wav_weight
 
     def sample_ray_differential(self, time, sample1, sample2, sample3, active=True):
         ray, weight = self.sample_ray(time, sample1, sample2, sample3, active)
@@ -90,7 +142,7 @@ def register() -> None:
 
 
 def sensor_dict(camera: Camera, *, spp: int, sampler: str = "ldsampler", seed: int = 0,
-                pixel_format: str = "rgb", name: str = "") -> dict:
+                pixel_format: str = "rgb", name: str = "", timed: bool = False) -> dict:
     """Mitsuba dict for our sensor with a float32 box-filtered film of the camera's size.
 
     The box filter keeps renders bitwise deterministic and pixel values unblurred across pixels.
@@ -98,11 +150,11 @@ def sensor_dict(camera: Camera, *, spp: int, sampler: str = "ldsampler", seed: i
     return {
         "type": SENSOR_PLUGIN,
         "camera_name": name,
+        # a shutter interval makes Mitsuba draw a time in [0, 1) per sample (motion blur)
+        **({"shutter_open": 0.0, "shutter_close": 1.0} if timed else {}),
         "film": {"type": "hdrfilm", "width": camera.width, "height": camera.height,
                  "rfilter": {"type": "box"}, "pixel_format": pixel_format, "component_format": "float32"},
         "sampler": {"type": sampler, "sample_count": int(spp), "seed": int(seed)},
     }
 
 
-def as_numpy_image(bitmap_tensor) -> np.ndarray:
-    return np.array(bitmap_tensor, dtype=np.float32)

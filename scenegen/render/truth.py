@@ -71,15 +71,33 @@ def _matvec(R, v):
                    R[2][0] * v.x + R[2][1] * v.y + R[2][2] * v.z)
 
 
-def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict[str, np.ndarray]:
-    """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring."""
+def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
+               row_poses: list[Rigid3] | None = None) -> dict[str, np.ndarray]:
+    """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring.
+
+    ``row_poses`` (rolling shutter): one ``cam_from_world`` per image row; each row's rays start
+    from its own pose and ``points_cam``, ``normals_cam``, ``depth_z`` are in that row's camera
+    frame. Without it every row uses ``cam_from_world``.
+    """
     if mi.variant().startswith("scalar"):
+        if row_poses is not None:
+            raise NotImplementedError("rolling-shutter truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
         return _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
     H, W = camera.height, camera.width
-    world_from_cam = cam_from_world.inverse()
-    Rwc = [[dr.opaque(mi.Float64, float(world_from_cam.R[i, j])) for j in range(3)] for i in range(3)]
+    if row_poses is None:
+        world_from_cam = cam_from_world.inverse()
+        Rwc = [[dr.opaque(mi.Float64, float(world_from_cam.R[i, j])) for j in range(3)] for i in range(3)]
+        C = mi.Vector3d(*[dr.opaque(mi.Float64, float(c)) for c in world_from_cam.t])
+    else:  # per-row poses, gathered by each pixel's row
+        if len(row_poses) != H:
+            raise ValueError(f"row_poses needs {H} poses (one per row), got {len(row_poses)}")
+        inv = [p.inverse() for p in row_poses]
+        R_rows = np.stack([w.R for w in inv])  # (H, 3, 3) world_from_cam per row
+        C_rows = np.stack([w.t for w in inv])  # (H, 3)
+        row = dr.arange(mi.UInt32, H * W) // W
+        Rwc = [[dr.gather(mi.Float64, mi.Float64(R_rows[:, i, j]), row) for j in range(3)] for i in range(3)]
+        C = mi.Vector3d(*[dr.gather(mi.Float64, mi.Float64(C_rows[:, i]), row) for i in range(3)])
     Rcw = [[Rwc[j][i] for j in range(3)] for i in range(3)]
-    C = mi.Vector3d(*[dr.opaque(mi.Float64, float(c)) for c in world_from_cam.t])
 
     d_cam = _camera_rays_dr(camera)
     d_world = _matvec(Rwc, d_cam)

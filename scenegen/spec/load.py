@@ -191,7 +191,7 @@ class _Parser:
         if node is None:
             return m.RenderSettings()
         f = node.as_mapping().check(
-            optional=("spp", "max_depth", "seed", "variant", "bit_depth", "sampler"))
+            optional=("spp", "max_depth", "seed", "variant", "bit_depth", "sampler", "motion_subframes"))
         spp = f.int("spp", 64, "samples per pixel", lo=1)
         max_depth = f.int("max_depth", 6, "path segments, -1 = unbounded", lo=-1)
         if max_depth == 0:
@@ -209,7 +209,8 @@ class _Parser:
             else "auto",
             bit_depth=f.get("bit_depth").as_enum(m.BIT_DEPTHS, "bit depth") if "bit_depth" in f
             else 8,
-            sampler=sampler, where=node.where)
+            sampler=sampler, motion_subframes=f.int("motion_subframes", 8, "sub-frames", lo=1, hi=256),
+            where=node.where)
 
     # -- textures and materials --------------------------------------------------------------
     def texture(self, node: Node) -> m.Texture:
@@ -275,7 +276,7 @@ class _Parser:
     def object(self, node: Node, index: int, materials: dict) -> m.SceneObject:
         f = node.as_mapping("an object (a mapping with 'name' and one of shape, mesh, target)")
         f.check(required=("name",),
-                optional=("shape", "mesh", "target", "transform", "material", "instance_id"))
+                optional=("shape", "mesh", "target", "transform", "material", "instance_id", "motion"))
         name = f.get("name").as_name("an object name")
         which = f.one_of(("shape", "mesh", "target"))
         if which == "shape":
@@ -301,7 +302,8 @@ class _Parser:
         object_id = index + 1
         instance_id = f.int("instance_id", object_id, lo=1, hi=_ID_MAX)
         return m.SceneObject(name=name, geometry=geometry, transform=transform, material=material,
-                             object_id=object_id, instance_id=instance_id, where=node.where)
+                             object_id=object_id, instance_id=instance_id,
+                             motion=self.motion(f.get("motion")) if "motion" in f else None, where=node.where)
 
     def shape(self, node: Node) -> m.Shape:
         if not node.is_mapping:
@@ -515,7 +517,8 @@ class _Parser:
     def camera(self, node: Node, name: str) -> m.CameraSpec:
         f = node.as_mapping("a camera (a mapping with model, size and fx, fy or fov_deg)")
         f.check(required=("size",),
-                optional=("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "imaging"))
+                optional=("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "imaging", "lens",
+                          "shutter", "chromatic_aberration"))
         model = f.get("model").as_enum(m.CAMERA_MODELS, "camera model") if "model" in f \
             else "pinhole"
         size_node = f.get("size")
@@ -559,7 +562,8 @@ class _Parser:
             dist = (0.0,) * allowed[0]
         cam = m.CameraSpec(name=name, model=model, width=W, height=H, fx=fx, fy=fy, cx=cx, cy=cy,
                            skew=skew, dist=dist, fov_deg=fov, where=node.where,
-                           imaging=self.imaging(f.get("imaging"), name) if "imaging" in f else None)
+                           imaging=self.imaging(f.get("imaging"), name) if "imaging" in f else None,
+                           optics=self.optics(f, model))
         if not (-0.5 <= cx <= W - 0.5 and -0.5 <= cy <= H - 0.5):
             self.warn(node, f"principal point ({cx:g}, {cy:g}) lies outside the image")
         _check_with_camera_model(cam, f.get("dist") or node)
@@ -701,7 +705,7 @@ class _Parser:
         f = node.as_mapping("a view set (camera or rig, and one of orbit, look_at, poses, "
                             "random, path)")
         placements = ("orbit", "look_at", "poses", "random", "path")
-        f.check(optional=("name", "camera", "rig") + placements)
+        f.check(optional=("name", "camera", "rig", "motion") + placements)
         name = f.get("name").as_name("a view set name") if "name" in f else None
         who = f.one_of(("camera", "rig"))
         camera = rig = None
@@ -719,7 +723,48 @@ class _Parser:
         parse = {"orbit": self.orbit, "look_at": self.look_at_list, "poses": self.poses,
                  "random": self.random, "path": self.path}[kind]
         placement = parse(pn, "rig" if rig else "cam")
-        return m.ViewSet(name=name, camera=camera, rig=rig, placement=placement, where=node.where)
+        return m.ViewSet(name=name, camera=camera, rig=rig, placement=placement,
+                         motion=self.motion(f.get("motion")) if "motion" in f else None, where=node.where)
+
+    # -- lens and time effects (scenegen/optics.py, docs/image_formation.md) -------------------
+    def optics(self, f, model: str):
+        """``lens``, ``shutter`` and ``chromatic_aberration`` of a camera, or None."""
+        from scenegen import optics as o
+
+        if not any(k in f for k in ("lens", "shutter", "chromatic_aberration")):
+            return None
+        lens = shutter = ca = None
+        if "lens" in f:
+            if model == "fisheye":
+                raise f.get("lens").error("the thin lens is for perspective models (pinhole, opencv); "
+                                          "a fisheye has no single focus plane")
+            lf = f.get("lens").as_mapping("a thin lens (f_number, focus_distance_m, pixel_pitch_um)").check(
+                required=("f_number", "focus_distance_m", "pixel_pitch_um"))
+            lens = o.ThinLens(f_number=lf.float("f_number", unit="unitless", lo=0.0, lo_open=True),
+                              focus_distance_m=lf.float("focus_distance_m", unit="metres", lo=0.0, lo_open=True),
+                              pixel_pitch_um=lf.float("pixel_pitch_um", unit="micrometres", lo=0.0, lo_open=True))
+        if "shutter" in f:
+            sf = f.get("shutter").as_mapping("a shutter (exposure_s, rolling_readout_s)").check(
+                optional=("exposure_s", "rolling_readout_s"))
+            shutter = o.Shutter(exposure_s=sf.float("exposure_s", 0.0, "seconds", lo=0.0),
+                                rolling_readout_s=sf.float("rolling_readout_s", 0.0, "seconds", lo=0.0))
+        if "chromatic_aberration" in f:
+            cf = f.get("chromatic_aberration").as_mapping(
+                "per-channel focal scales (red_focal_scale, blue_focal_scale)").check(
+                optional=("red_focal_scale", "blue_focal_scale"))
+            ca = o.ChromaticAberration(
+                red_focal_scale=cf.float("red_focal_scale", 1.0, "unitless", lo=0.5, hi=2.0),
+                blue_focal_scale=cf.float("blue_focal_scale", 1.0, "unitless", lo=0.5, hi=2.0))
+        return o.Optics(lens=lens, shutter=shutter, chromatic_aberration=ca)
+
+    def motion(self, node: Node):
+        """Constant linear (m/s) and angular (deg/s, rotation vector) velocities."""
+        from scenegen.optics import Motion
+
+        f = node.as_mapping("a motion (linear_velocity_mps, angular_velocity_deg_s)").check(
+            optional=("linear_velocity_mps", "angular_velocity_deg_s"))
+        return Motion(linear_velocity_mps=f.vec3("linear_velocity_mps", (0.0, 0.0, 0.0), "metres / second"),
+                      angular_velocity_deg_s=f.vec3("angular_velocity_deg_s", (0.0, 0.0, 0.0), "degrees / second"))
 
     def orbit(self, node: Node, frame: str) -> m.Orbit:
         f = node.as_mapping("an orbit (center, radius_m, elevations_deg, count)").check(

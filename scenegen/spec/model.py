@@ -79,6 +79,7 @@ class RenderSettings:
     variant: str = "auto"  # one of RENDER_VARIANTS; 'auto' lets the renderer pick
     bit_depth: int = 8  # PNG bits per channel of the rendered images: 8 or 16
     sampler: str = "ldsampler"  # one of SAMPLERS (Mitsuba sampler plugin name)
+    motion_subframes: int = 8  # sub-frames averaged when objects move during the exposure
     where: Where | None = field(**_WHERE)
 
 
@@ -248,6 +249,7 @@ class SceneObject:
     material: Material  # resolved: the named material from `materials:` or an inline one
     object_id: int  # 1-based position in `objects:` (0 is the background in id images)
     instance_id: int  # as given, default = object_id (>= 1; may be shared between objects)
+    motion: Any = None  # scenegen.optics.Motion in the world, about the object origin; None = static
     where: Where | None = field(**_WHERE)
 
 
@@ -331,6 +333,8 @@ class CameraSpec:
     dist: tuple[float, ...] = ()  # distortion coefficients (unitless), see above
     fov_deg: float | None = None  # horizontal FoV of the undistorted pinhole as written (fx, fy
     # derived from it: fx = fy = (W/2) / tan(fov/2)), degrees
+    optics: Any = None  # scenegen.optics.Optics: thin lens, shutter (motion blur, rolling
+    # shutter), chromatic aberration; None = a pinhole with an instantaneous global shutter
     imaging: Any = None  # scenegen.imaging.ImagingParams: the photometric chain (exposure,
     # vignetting, EMVA 1288 sensor, Bayer, response; docs/image_formation.md); None = the clean
     # sRGB encoding of the linear render
@@ -450,6 +454,7 @@ class ViewSet:
     camera: str | None  # a key of `cameras:` (exactly one of camera / rig)
     rig: str | None  # a key of `rigs:`
     placement: Placement  # where the camera (or the rig frame) goes
+    motion: Any = None  # scenegen.optics.Motion of the placed camera / rig frame (body velocities)
     where: Where | None = field(**_WHERE)
 
     @property
@@ -468,6 +473,7 @@ class View:
     rig_member: str | None = None  # member name in the rig ('left', 'right', ...)
     frame_index: int = 0  # placement counter over all view sets; a rig's members share it
     view_set: int = 0  # index of the view set in `views:`
+    motion: Any = None  # scenegen.optics.Motion of this camera, in its own frame; None = static
 
 
 # ---------------------------------------------------------------------------------------------

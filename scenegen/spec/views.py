@@ -41,7 +41,7 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
             if vs.camera is not None:
                 views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
                                     cam_from_world=world_from_x.inverse(), frame_index=frame,
-                                    view_set=set_index))
+                                    view_set=set_index, motion=vs.motion))
             else:
                 rig = spec.rigs[vs.rig]
                 for member in rig.members:
@@ -49,7 +49,8 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                     views.append(m.View(
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
                         cam_from_world=world_from_cam.inverse(), rig=rig.name,
-                        rig_member=member.name, frame_index=frame, view_set=set_index))
+                        rig_member=member.name, frame_index=frame, view_set=set_index,
+                        motion=_member_motion(vs.motion, member.rig_from_cam)))
             frame += 1
     return tuple(views)
 
@@ -133,3 +134,17 @@ def random_eyes_targets(p: m.RandomPoses, vs: m.ViewSet | None = None
         eyes.append(eye)
         targets.append(target)
     return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)
+
+
+def _member_motion(rig_motion, rig_from_cam: Rigid3):
+    """A rig's body velocities seen by one member camera: omega_cam = R^T omega,
+    v_cam = R^T (v + omega x t), with rig_from_cam = (R, t)."""
+    if rig_motion is None:
+        return None
+    from scenegen.optics import Motion
+
+    R, t = rig_from_cam.R, rig_from_cam.t
+    w = np.radians(np.asarray(rig_motion.angular_velocity_deg_s, dtype=np.float64))
+    v = np.asarray(rig_motion.linear_velocity_mps, dtype=np.float64)
+    return Motion(linear_velocity_mps=tuple(R.T @ (v + np.cross(w, t))),
+                  angular_velocity_deg_s=tuple(np.degrees(R.T @ w)))
