@@ -13,8 +13,9 @@ from scenegen.dataset import Dataset, verify
 #: Issue 4: the image ratio with / without vignetting must reproduce the saved map within 1 %.
 RATIO_REL_TOL = 0.01
 
-# A uniform environment (radiance 0.3 in every direction) and nothing else: every pixel of the
-# clean render sees the same radiance, a flat field. Camera `vig` vignettes, `flat` does not;
+# A flat white Lambertian wall facing the cameras: an emitting Lambertian panel (a light box, the
+# usual flat-field target) of radiance 0.3, so every pixel sees exactly the same radiance and the
+# clean render has no Monte Carlo noise (a reflecting wall would carry the path tracer's noise). Camera `vig` vignettes, `flat` does not;
 # both have temporal and fixed-pattern noise off so that the ratio is the map itself (noise, and
 # the ratio under noise, are tested in test_imaging_noise / test_imaging_vignetting).
 SPEC = """
@@ -22,7 +23,7 @@ name: flatfield
 seed: 3
 render: {spp: 4, max_depth: 2, bit_depth: 16}
 lights:
-  - {type: constant, radiance: 0.3}
+  - {type: area, name: wall, size: [40, 40], position: [1.0, 0, 0], look_at: [0, 0, 0], radiance: 0.3}
 cameras:
   vig:
     model: opencv

@@ -247,3 +247,15 @@ class TestPoseFile:
         (tmp_path / "bad.txt").write_text("1 2 3\n")
         with pytest.raises(InputError, match="bad.txt: expected a 3x4 or 4x4"):
             read_pose(tmp_path / "bad.txt")
+
+
+def test_readers_import_no_mitsuba(plane_dataset):
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from recon_eval.readers import scenegen_dataset, nerf, kitti_odometry, exr, opencv_calib, pose_file\n"
+            f"d = scenegen_dataset.read_dataset({str(plane_dataset[0])!r}); d.depth('left_000'); d.camera('free_000')\n"
+            "import recon_eval.plots, recon_eval.html_report\n"
+            "assert not any(m.split('.')[0] in ('mitsuba', 'drjit') for m in sys.modules), 'mitsuba imported'\n")
+    subprocess.run([sys.executable, "-c", code], check=True)
