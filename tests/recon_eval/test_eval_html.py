@@ -8,7 +8,6 @@ import pytest
 
 from recon_eval.cli import main
 
-pytest.importorskip("matplotlib")
 
 VOID = {"meta", "img", "br", "hr", "link", "input"}
 
