@@ -13,6 +13,26 @@ CAM = "cameras:\n  cam: {size: [640, 480], fov_deg: 60}\n"
 
 # (id, spec text, line, field path (None: none), message fragment)
 CASES = [
+    ("lens_on_fisheye",
+     "cameras:\n  f:\n    model: fisheye\n    size: [64, 64]\n    fx: 30\n    dist: [0, 0, 0, 0]\n"
+     "    lens: {f_number: 2, focus_distance_m: 1, pixel_pitch_um: 3}\n",
+     7, "cameras.f.lens", "the thin lens is for perspective models"),
+    ("lens_missing_pitch",
+     "cameras:\n  c:\n    size: [64, 64]\n    fx: 30\n    lens: {f_number: 2, focus_distance_m: 1}\n",
+     5, "cameras.c.lens.pixel_pitch_um", "missing required key 'pixel_pitch_um'"),
+    ("negative_exposure",
+     "cameras:\n  c:\n    size: [64, 64]\n    fx: 30\n    shutter: {exposure_s: -0.01}\n",
+     5, "cameras.c.shutter.exposure_s", "seconds"),
+    ("unknown_shutter_key_suggests",
+     "cameras:\n  c:\n    size: [64, 64]\n    fx: 30\n    shutter: {rolling_readout: 0.01}\n",
+     5, "cameras.c.shutter.rolling_readout", "(did you mean 'rolling_readout_s'?)"),
+    ("motion_wrong_length",
+     CAM + "views:\n  - camera: cam\n    motion: {linear_velocity_mps: [1, 0]}\n"
+     "    orbit: {radius_m: 2, count: 4}\n",
+     5, "views[0].motion.linear_velocity_mps", "expected 3 numbers (metres / second)"),
+    ("chromatic_scale_out_of_range",
+     "cameras:\n  c:\n    size: [64, 64]\n    fx: 30\n    chromatic_aberration: {red_focal_scale: 3}\n",
+     5, "cameras.c.chromatic_aberration.red_focal_scale", "2"),
     ("unknown_top_level_key_suggests",
      "name: x\nobject:\n  - {name: a, shape: sphere}\n",
      2, "object", "unknown key 'object' (did you mean 'objects'?)"),
