@@ -419,35 +419,20 @@ class Camera:
         p = SimpleNamespace(**{**vars(self._raw_params()), "limit": limit})
         yd = (grid[:, 1] - p.cy) / p.fy
         xd = (grid[:, 0] - p.cx - p.skew * yd) / p.fx
-        worst = 0
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             if self.model == "opencv":
-                x, y = xd, yd
-                done = np.zeros(len(xd), bool)
-                for it in range(MAX_UNDISTORT_ITERATIONS + 1):
-                    ex, ey = distort_opencv_xy(x, y, p)
-                    res_px = np.hypot((ex - xd) * p.fx, (ey - yd) * p.fy)
-                    newly = ~done & (res_px <= UNDISTORT_TOL_PX)
-                    if newly.any():
-                        worst = it
-                    done |= newly
-                    if done.all():
-                        break
-                    x, y = newton_step_opencv_xy(x, y, xd, yd, p)
+                def residual_px(xy):
+                    ex, ey = distort_opencv_xy(xy[0], xy[1], p)
+                    return np.hypot((ex - xd) * p.fx, (ey - yd) * p.fy)
+
+                (x, y), done, worst = _newton_until_converged(
+                    (xd, yd), residual_px, lambda xy: newton_step_opencv_xy(xy[0], xy[1], xd, yd, p))
                 bad = ~done | (x * x + y * y > limit)
             else:
                 theta_d = np.hypot(xd, yd)
-                theta = theta_d.copy()
-                done = np.zeros(len(xd), bool)
-                for it in range(MAX_UNDISTORT_ITERATIONS + 1):
-                    res_px = np.abs(fisheye_theta_d(theta, p) - theta_d) * min(p.fx, p.fy)
-                    newly = ~done & (res_px <= UNDISTORT_TOL_PX)
-                    if newly.any():
-                        worst = it
-                    done |= newly
-                    if done.all():
-                        break
-                    theta = theta - (fisheye_theta_d(theta, p) - theta_d) / fisheye_dtheta_d(theta, p)
+                theta, done, worst = _newton_until_converged(
+                    theta_d, lambda th: np.abs(fisheye_theta_d(th, p) - theta_d) * min(p.fx, p.fy),
+                    lambda th: th - (fisheye_theta_d(th, p) - theta_d) / fisheye_dtheta_d(th, p))
                 bad = ~done | (theta > limit)
         if bad.any():
             u, v = grid[np.argmax(bad)]
@@ -572,3 +557,23 @@ class Camera:
             model, dist = "pinhole", ()
         return cls(model, width, height, fx, fy, float(cx), float(cy), 0.0, tuple(dist))
 
+
+
+def _newton_until_converged(state, residual_px, step):
+    """Iterate ``step`` from ``state`` until every point's residual (px) is <= UNDISTORT_TOL_PX.
+
+    Returns (final state, converged mask, the iteration count the slowest converged point needed).
+    """
+    done = None
+    worst = 0
+    for it in range(MAX_UNDISTORT_ITERATIONS + 1):
+        res = residual_px(state)
+        done = np.zeros(res.shape, bool) if done is None else done
+        newly = ~done & (res <= UNDISTORT_TOL_PX)
+        if newly.any():
+            worst = it
+        done |= newly
+        if done.all():
+            break
+        state = step(state)
+    return state, done, worst

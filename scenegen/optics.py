@@ -11,7 +11,6 @@ row v (OpenCV pixel row, 0 = top) is exposed around ``row_time_s(v)``; the middl
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -145,7 +144,3 @@ def motion_to_dict(motion: Motion | None) -> dict | None:
     return {"linear_velocity_mps": list(motion.linear_velocity_mps),
             "angular_velocity_deg_s": list(motion.angular_velocity_deg_s)}
 
-
-def _finite_positive(name: str, v: float) -> None:
-    if not (math.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be a positive number, got {v!r}")

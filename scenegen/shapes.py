@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from scenegen._checks import count as _count, positive as _positive
+
 #: File extensions :func:`load_mesh` accepts.
 MESH_EXTENSIONS = (".ply", ".obj", ".glb", ".gltf", ".stl")
 
@@ -48,19 +50,6 @@ def _mesh(vertices, faces, uv) -> trimesh.Trimesh:
     uv = np.ascontiguousarray(uv, dtype=np.float64)
     return trimesh.Trimesh(vertices=vertices, faces=faces,
                            visual=trimesh.visual.TextureVisuals(uv=uv), process=False)
-
-
-def _positive(name: str, value) -> float:
-    v = float(value)
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be a positive number, got {value!r}")
-    return v
-
-
-def _count(name: str, value, minimum: int) -> int:
-    if int(value) != value or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
 
 
 def _grid_faces(rows: int, cols: int, flip: bool = False) -> np.ndarray:

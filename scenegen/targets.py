@@ -41,6 +41,7 @@ import cv2
 import numpy as np
 import trimesh
 
+from scenegen._checks import count as _count, positive as _positive
 from scenegen.pose import Rigid3
 
 BoardKind = str  # 'checkerboard' | 'charuco' | 'aruco'
@@ -207,19 +208,6 @@ def _whole_px(name: str, value_px: float) -> int:
         raise ValueError(f"{name} is {value_px:.6g} px; it must be a whole number of pixels "
                          "(choose px_per_square / px_per_marker to make it one)")
     return n
-
-
-def _positive(name: str, value) -> float:
-    v = float(value)
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be a positive number, got {value!r}")
-    return v
-
-
-def _count(name: str, value, minimum: int) -> int:
-    if int(value) != value or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
 
 
 def _margin_px(margin_squares, margin_m, square_m: float, px_per_square: int) -> int:

@@ -20,7 +20,7 @@ from scenegen.spec import model as m
 from scenegen.spec._yaml import Document, Fields, Node, suggest
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview")
+                  "cameras", "rigs", "views", "crossview", "variation")
 _SEED_MAX = 2**32 - 1
 _ID_MAX = 2**31 - 1
 
@@ -92,12 +92,18 @@ class _Parser:
         _unique_names(f.get("lights"), lights, "light")
         view_sets = self.list_section(f, "views", self.view_set, cameras, rigs)
         crossview = self.crossview(f.get("crossview")) if "crossview" in f else None
+        variation = None
+        if "variation" in f:  # seeded ranges for --variants (scenegen/spec/variation.py)
+            from scenegen.spec.variation import parse_variation
+
+            variation = parse_variation(f.get("variation"), scene_seed=self.seed, objects=objects,
+                                        lights=lights, cameras=cameras, derive_seed=derive_seed)
         spec = m.SceneSpec(
             name=name, description=description, seed=self.seed, render=render,
             materials=m.frozen_mapping(materials), objects=tuple(objects), lights=tuple(lights),
             cameras=m.frozen_mapping(cameras), rigs=m.frozen_mapping(rigs),
             view_sets=tuple(view_sets), file=self.doc.file, base_dir=self.doc.base_dir,
-            warnings=tuple(self.warnings), crossview=crossview)
+            warnings=tuple(self.warnings), crossview=crossview, variation=variation)
         from scenegen.spec.views import resolve_views
 
         views = resolve_views(spec)  # degenerate placements are errors now, not at render time

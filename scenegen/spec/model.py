@@ -527,3 +527,7 @@ class SceneSpec:
     base_dir: Path = field(default_factory=Path.cwd)  # directory relative paths resolve against
     warnings: tuple[str, ...] = ()  # non-fatal remarks, each 'file:line: field: message'
     crossview: CrossviewSpec | None = None  # cross-view truth to write; None = none
+    variation: Any = None  # scenegen.spec.variation.VariationSpec: seeded ranges for
+    # `scenegen render --variants N`; None = no variation declared
+    variant: Mapping[str, Any] | None = None  # a derived variant's index, seed and drawn values
+    # (scenegen.variation.derive_variant); None for the spec as written

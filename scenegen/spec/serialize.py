@@ -97,6 +97,9 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         "rigs": _plain(spec.rigs),
         "view_sets": _plain(spec.view_sets),
         "views": views,
+        # only when declared, so that specs without variation keep their hashes
+        **({"variation": _plain(spec.variation)} if spec.variation is not None else {}),
+        **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
     }
 
 
