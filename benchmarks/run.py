@@ -1,6 +1,6 @@
 """Run every benchmark (`make bench`): each prints ratios measured in the same run.
 
-Figures are recorded in docs/performance.md (render, truth) and docs/metrics.md (F-score).
+Figures are recorded in docs/performance.md (render, truth, scale) and docs/metrics.md (F-score).
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ HERE = Path(__file__).resolve().parent
 
 if __name__ == "__main__":
     failed = 0
-    for script in ("bench_render.py", "bench_fscore.py"):
+    for script in ("bench_render.py", "bench_fscore.py", "bench_scale.py"):
         print(f"== {script}", flush=True)
         failed |= subprocess.call([sys.executable, str(HERE / script)])
     sys.exit(failed)

@@ -123,6 +123,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--points-world", help="non-dataset truth: (N, 3) .npy world points for reprojection")
     p.add_argument("--pixels", help="non-dataset truth: (N, 2) .npy pixels observing them")
     p.add_argument("--calib", help="non-dataset truth: camera for reprojection (OpenCV YAML/JSON)")
+    from recon_eval.cli_tools import add_parsers  # run, leaderboard, gate (docs/ci.md)
+
+    add_parsers(sub)
     return ap
 
 
@@ -690,6 +693,10 @@ _COMMANDS = {"cloud": _cmd_cloud, "poses": _cmd_poses, "disparity": _cmd_dispari
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)  # argparse itself exits with code 2 on bad usage
+    from recon_eval import cli_tools
+
+    if args.command in cli_tools.COMMANDS:
+        return cli_tools.handle(args)
     from recon_eval.errors import InputError
     from recon_eval.report import document, print_table, write_json_atomic
 

@@ -42,15 +42,28 @@ def cmd_validate(args) -> int:
 def cmd_render(args) -> int:
     from scenegen.pipeline import render_spec
 
+    many = args.variants is not None or args.workers is not None or args.scheduler is not None
     with warnings.catch_warnings():
         warnings.simplefilter("always")
-        s = render_spec(args.spec, args.output, frames=args.frames, spp=args.spp, seed=args.seed,
-                        variant=args.variant, resume=args.resume, progress=not args.quiet)
+        kw = dict(frames=args.frames, spp=args.spp, seed=args.seed, variant=args.variant,
+                  resume=args.resume, progress=not args.quiet)
+        if many:  # variants and/or Dask workers (scenegen/batch.py)
+            from scenegen.batch import render_many
+
+            summaries = render_many(args.spec, args.output, variants=args.variants,
+                                    workers=args.workers, scheduler=args.scheduler, **kw)
+        else:
+            summaries = [render_spec(args.spec, args.output, **kw)]
+    for s in summaries:
+        _print_summary(s)
+    return 0
+
+
+def _print_summary(s) -> None:
     per = s.seconds / max(s.views_rendered, 1)
     print(f"wrote {s.out_dir}: {s.views_rendered} views rendered, {s.views_skipped} already complete, "
           f"{s.seconds:.1f} s ({per:.2f} s/view), variant {s.settings.variant}, spp {s.settings.spp}")
     print(f"  images: {s.out_dir / 'images'}   truth: {s.out_dir / 'truth'}   cameras: {s.out_dir / 'cameras.json'}")
-    return 0
 
 
 def cmd_info(args) -> int:
@@ -105,6 +118,11 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--variant", choices=("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb"))
     r.add_argument("--resume", action="store_true", help="finish an interrupted run in the same folder")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--variants", type=int, metavar="N",
+                   help="render variants 0..N-1 of the spec's 'variation:' section into OUT/variant_0000, ...")
+    where = r.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N", help="render on a local Dask cluster of N worker processes")
+    where.add_argument("--scheduler", metavar="ADDRESS", help="render on an existing Dask cluster, e.g. tcp://host:8786")
     r.set_defaults(fn=cmd_render)
     i = sub.add_parser("info", help="summarise a dataset")
     i.add_argument("dataset", type=Path)

@@ -496,6 +496,25 @@ class DatasetWriter:
     def record_view(self, view: str, file_hashes: Mapping[str, str]) -> None:
         """Mark ``view`` complete with the files (``{relative path: sha256}``) already written,
         e.g. by :func:`write_view_files` in a worker; rewrites the manifest atomically."""
+        self._record(view, file_hashes)
+        self._write_manifest()
+
+    def record_views(self, views: Mapping[str, Mapping[str, str]]) -> None:
+        """:meth:`record_view` for several views (``{view: {relative path: sha256}}``, in order)
+        with one manifest rewrite: the manifest's size grows with the run, so a client recording
+        many workers' views batches what is ready. Nothing is recorded if any view is invalid."""
+        views = dict(views)
+        snapshot = ({v: {"status": e["status"], "files": list(e["files"])} for v, e in self._views.items()},
+                    dict(self._files))
+        try:
+            for view, file_hashes in views.items():
+                self._record(view, file_hashes)
+        except Exception:
+            self._views, self._files = snapshot
+            raise
+        self._write_manifest()
+
+    def _record(self, view: str, file_hashes: Mapping[str, str]) -> None:
         _check_view_name(view)
         for rel, sha in file_hashes.items():
             _check_rel_path(rel)
@@ -509,7 +528,6 @@ class DatasetWriter:
             self._files.pop(rel, None)
         self._files.update(file_hashes)
         self._views[view] = {"status": STATUS_COMPLETE, "files": sorted(file_hashes)}
-        self._write_manifest()
 
     def close(self) -> None:
         """Write the manifest a last time (every method already leaves it up to date)."""

@@ -75,13 +75,20 @@ def _truth_for_storage(truth: dict) -> dict:
 
 def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | None = None,
                 seed: int | None = None, variant: str | None = None, resume: bool = False,
-                progress: bool = True) -> RenderSummary:
+                progress: bool = True, dask_client=None) -> RenderSummary:
     """Render every selected view of a spec into ``out_dir`` (see docs/dataset_format.md).
+
+    ``spec_path``: a spec file, or a :class:`scenegen.variation.SpecSource` (e.g. a variant).
+    ``dask_client``: a ``distributed.Client``; its workers render and write the views, this
+    process records them in the run's order (scenegen/distributed.py); None = render here.
 
     Raises :class:`scenegen.errors.SpecError` for a bad spec, ``ValueError`` for bad options,
     :class:`scenegen.dataset.DatasetError` for an unusable output directory.
     """
-    spec = load_spec(spec_path)
+    from scenegen.variation import SpecSource
+
+    source = spec_path if isinstance(spec_path, SpecSource) else None
+    spec = source.load() if source is not None else load_spec(spec_path)
     views = resolve_views(spec)
     n_frames = 1 + max((v.frame_index for v in views), default=-1)
     wanted = parse_frames(frames, n_frames)
@@ -94,8 +101,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     from scenegen.render.backend import load_mitsuba
 
     mi = load_mitsuba(variant or rs.variant)
-    from scenegen.render.scene import build_scene, render_view
-    from scenegen.render.truth import truth_pass
+    from scenegen.render.scene import build_scene
 
     used = RenderSettingsUsed(spp=spp, seed=seed, variant=mi.variant(), sampler=rs.sampler,
                               max_depth=rs.max_depth, bit_depth=rs.bit_depth)
@@ -113,7 +119,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
     resolved["objects_ids"] = built.objects
-    from scenegen.imaging.stage import apply_imaging, imaging_record  # docs/image_formation.md
+    from scenegen.imaging.stage import imaging_record  # docs/image_formation.md
 
     if (imaging := imaging_record(spec, views)) is not None:
         resolved["imaging_used"] = imaging
@@ -127,22 +133,21 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     skipped = sum(writer.is_complete(v.name) for _, v in todo)
     rendered = 0
     with _progress(progress, len(todo)) as bar:
-        for index, v in todo:
+        if dask_client is not None:  # workers render and write; recorded here in the run's order
+            from scenegen.distributed import render_views_dask
+
+            for _ in range(skipped):
+                bar.advance()
+            pending = [(index, v) for index, v in todo if not writer.is_complete(v.name)]
+            rendered = render_views_dask(
+                dask_client, source or SpecSource.from_path(spec_path), writer, pending, spp=spp,
+                seed=seed, variant=used.variant, on_done=bar.advance)
+        for index, v in todo if dask_client is None else ():
             if writer.is_complete(v.name):
                 bar.advance()
                 continue
-            linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index),
-                                 motion=v.motion)
-            truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables,
-                               row_poses=rolling_shutter_rows(built, v))
-            params = spec.cameras[v.camera].imaging
-            if params is None:  # clean path: sRGB encoding of the linear render
-                image, extra = encode_image(linear, rs.bit_depth), None
-            else:  # the camera's photometric chain; its vignetting map is saved as truth
-                image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed,
-                                             index, v.name)
-            writer.write_view(v.name, image=image, linear_rgb=linear,
-                              truth=_truth_for_storage(truth), extra_files=extra)
+            image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
+            writer.write_view(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra)
             rendered += 1
             bar.advance()
     from scenegen.crossview.stage import run_crossview  # cross-view truth (docs/crossview.md)
@@ -151,6 +156,25 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                   spp=spp, seed=seed)
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)
+
+
+def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
+    """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
+    :func:`scenegen.dataset.encode_view`; ``index`` is the view's position in the run's order."""
+    from scenegen.imaging.stage import apply_imaging
+    from scenegen.render.scene import render_view
+    from scenegen.render.truth import truth_pass
+
+    linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index),
+                         motion=v.motion)
+    truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables,
+                       row_poses=rolling_shutter_rows(built, v))
+    params = spec.cameras[v.camera].imaging
+    if params is None:  # clean path: sRGB encoding of the linear render
+        image, extra = encode_image(linear, spec.render.bit_depth), None
+    else:  # the camera's photometric chain; its vignetting map is saved as truth
+        image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name)
+    return image, linear, _truth_for_storage(truth), extra
 
 
 def rolling_shutter_rows(built, view):

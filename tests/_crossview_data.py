@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import functools
 
-# A verged stereo rig over speckle-textured planes, a sphere (occluder) and a checkerboard, plus
-# a free camera with other intrinsics. Both rig members use ONE camera: build_scene currently
-# maps two same-size cameras onto one Mitsuba sensor (see the report on issue 5).
+# A verged stereo rig (two cameras with different intrinsics and distortion) over speckle-textured
+# planes, a sphere (occluder) and a checkerboard, plus a free camera of another size.
 SPEC = """
 name: crossview_test
 seed: 3
@@ -35,9 +34,10 @@ lights:
   - {type: constant, radiance: 0.3}
 cameras:
   left: {model: opencv, size: [200, 150], fx: 170, fy: 171, cx: 99.2, cy: 74.8, dist: [-0.05, 0.01, 0.0005, -0.0003, 0]}
+  right: {model: opencv, size: [200, 150], fx: 172, fy: 170, cx: 100.5, cy: 74.0, dist: [-0.048, 0.009, 0.0002, -0.0001]}
   side: {model: opencv, size: [176, 132], fx: 150, fy: 152, cx: 88.7, cy: 65.1, dist: [0.03, -0.01, 0, 0]}
 rigs:
-  st: {type: stereo, left: left, right: left, baseline_m: 0.12, vergence_deg: 2.0}
+  st: {type: stereo, left: left, right: right, baseline_m: 0.12, vergence_deg: 2.0}
 views:
   - rig: st
     path: {line: {from: [-0.2, -1.5, 1.2], to: [0.2, -1.45, 1.25]}, count: 2, target: [0, 0.8, 0.6]}

@@ -144,3 +144,82 @@ def test_layout_is_hashed_and_verifies(ds):
     assert idx["occlusion_rel_tol"] == 1e-4
     c = sio.read_exr(ds.path("crossview/corr/st_left_0000/side_0002.exr"))
     assert c["u"].dtype == np.float32 and c["state"].dtype == np.uint32
+
+
+def test_spec_section_and_pair_selection(tmp_path):
+    from scenegen.crossview.stage import consecutive_pairs, select_pairs
+    from scenegen.spec import parse_spec, resolve_views
+
+    text = ("cameras:\n  cam: {size: [64, 48], fov_deg: 60}\n"
+            "rigs:\n  st: {type: stereo, left: cam, right: cam, baseline_m: 0.1}\n"
+            "views:\n  - camera: cam\n    orbit: {radius_m: 2, count: 3}\n"
+            "  - rig: st\n    orbit: {radius_m: 2, count: 2}\n")
+    assert parse_spec(text, base_dir=tmp_path).crossview is None  # no section: no cross-view files
+    spec = parse_spec(text + "crossview: {}\n", base_dir=tmp_path)
+    cv = spec.crossview
+    assert (cv.pairs, cv.flow, cv.stereo, cv.matches, cv.sift, cv.targets) == ("consecutive", True, True, None, False, True)
+    views = resolve_views(spec)
+    assert consecutive_pairs(views) == [
+        ("cam_0000", "cam_0001"), ("cam_0001", "cam_0002"), ("st_left_0003", "st_right_0003"),
+        ("st_left_0003", "st_left_0004"), ("st_right_0003", "st_right_0004"), ("st_left_0004", "st_right_0004")]
+    assert len(select_pairs("all", views)) == 7 * 6 // 2 and select_pairs("none", views) == []
+    spec = parse_spec(text + "crossview:\n  pairs: [[cam_0000, st_right_0004]]\n  matches: {count: 5}\n",
+                      base_dir=tmp_path)
+    assert spec.crossview.pairs == (("cam_0000", "st_right_0004"),) and spec.crossview.matches.count == 5
+
+
+TINY_STEREO = """
+render: {spp: 4, max_depth: 2}
+objects:
+  - {name: wall, shape: {type: plane, size: [4, 4]}, transform: {translation: [0, 2, 0], rotation_deg: [90, 0, 0]}}
+  - {name: ball, shape: {type: sphere, radius: 0.2}, transform: {translation: [0, 1, 0]}}
+lights: [{type: constant, radiance: 1.0}]
+cameras:
+  cam: {size: [64, 48], fov_deg: 60}
+rigs:
+  st: {type: stereo, left: cam, right: cam, baseline_m: 0.1}
+views:
+  - rig: st
+    path: {line: {from: [-0.1, -1, 0], to: [0.1, -1, 0]}, count: 2, target: [0, 2, 0]}
+crossview: {matches: {count: 20}}
+"""
+
+
+def test_partial_runs_then_resume_equal_one_full_run(tmp_path):
+    """--frames 0 then --resume writes the same bytes (every hash in the manifest) as one run;
+    the partial run writes no index."""
+    from scenegen.pipeline import render_spec
+
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(TINY_STEREO)
+    render_spec(spec, tmp_path / "a", frames="0", progress=False)
+    assert not (tmp_path / "a/crossview/index.json").exists()
+    assert (tmp_path / "a/crossview/stereo/st_left_0000/disp_left.pfm").is_file()
+    render_spec(spec, tmp_path / "a", resume=True, progress=False)
+    render_spec(spec, tmp_path / "b", progress=False)
+    ma, mb = Dataset(tmp_path / "a").manifest, Dataset(tmp_path / "b").manifest
+    assert ma["files"] == mb["files"] and "crossview/index.json" in ma["files"]
+    assert verify(tmp_path / "a").ok
+
+
+def test_board_truth_charuco_markers_and_back_side():
+    """numpy-only: a ChArUco board seen from its printed side, then from behind."""
+    from scenegen.camera import Camera
+    from scenegen.crossview.targets import board_view_truth
+    from scenegen.pose import Rigid3
+    from scenegen.targets import charuco_board
+
+    board = charuco_board(5, 4, 0.04, 0.03, px_per_square=20)
+    cam = Camera("opencv", 320, 240, 300.0, 300.0, 159.5, 119.5, 0.0, (-0.1, 0.01, 0, 0))
+    # the print faces the board's -z: a camera at z = -0.5 looking along +z sees it upright
+    cam_from_board = Rigid3(np.eye(3), [-board.width_m / 2, -board.height_m / 2, 0.5])
+    world_from_board = Rigid3.identity()
+    t = board_view_truth(board, world_from_board, cam, cam_from_board, lambda C, X: np.ones(len(X), bool))
+    assert t["state"] == [cc.VISIBLE] * len(board.point_ids) and all(t["facing"])
+    M = len(board.marker_ids)
+    assert t["marker_ids"] == board.marker_ids.tolist() and len(t["marker_corners"]["uv"]) == M
+    uv = np.array(t["marker_corners"]["uv"]).reshape(-1, 2)
+    assert np.allclose(uv, cam.project(cam_from_board.apply(board.marker_corners_board.reshape(-1, 3))), atol=1e-12)
+    behind = Rigid3(np.diag([-1.0, 1.0, -1.0]), [board.width_m / 2, -board.height_m / 2, 0.5])  # from +z
+    t = board_view_truth(board, world_from_board, cam, behind, lambda C, X: np.ones(len(X), bool))
+    assert not any(t["facing"]) and set(t["state"]) == {cc.OCCLUDED}

@@ -18,12 +18,12 @@ from scenegen.pose import Rigid3
 # R1, R2: the same closed-form arithmetic as OpenCV (Rodrigues in scipy vs OpenCV), ~1e-16.
 TOL_ROT = 1e-12
 # Principal point of the rectified camera vs OpenCV: OpenCV undistorts the image corners with
-# cv2.undistortPoints' fixed 5-iteration loop, which stops ~1e-3 px short on these distortions
-# (we unproject exactly); measured 1e-4 .. 2e-3 px.
-TOL_PRINCIPAL_PX = 0.01
-# Rectification maps vs cv2.initUndistortRectifyMap: OpenCV computes them in double and stores
-# float32 (~1e-5 px at 320 px); measured ~3e-5 px.
-TOL_MAP_PX = 1e-3
+# cv2.undistortPoints' fixed-iteration loop, which stops short of the exact inverse we use
+# (measured 8e-7 .. 3.4e-6 px on these distortions); 1e-4 px leaves margin for stronger ones.
+TOL_PRINCIPAL_PX = 1e-4
+# Rectification maps vs cv2.initUndistortRectifyMap: OpenCV stores float32 (half an ulp at
+# 320 px is 1.5e-5 px, exactly what is measured).
+TOL_MAP_PX = 1e-4
 # Stored (float32) rectified correspondences vs f B / Z: float32 rounding of u (~1e-5 px).
 TOL_DISP_PX = 1e-4
 # The issue's bound on StereoSGBM's median (signed) disparity error on non-occluded pixels.

@@ -1,8 +1,6 @@
 """Cross-view truth against geometry and independent implementations (issue 5, "What it must
 show"): ray casts from view j, the i -> j -> i cycle, epipolar geometry (ours vs
 cv2.findFundamentalMat), plane homographies, and occlusion masks vs an analytic occluder."""
-import math
-
 import cv2
 import numpy as np
 import pytest
@@ -11,10 +9,8 @@ from _crossview_data import built_scene, rendered
 from scenegen import io as sio
 from scenegen.camera import Camera
 from scenegen.crossview import correspondence as cc
-from scenegen.crossview.twoview import (TwoView, fundamental, plane_homography, plane_in_camera, sampson_error,
-                                        undistorted_pixels)
+from scenegen.crossview.twoview import TwoView, fundamental, plane_homography, sampson_error, undistorted_pixels
 from scenegen.dataset import Dataset
-from scenegen.pose import look_at
 
 # A ray cast from j through the stored correspondence hits pixel i's truth point within this
 # fraction of its depth: the issue's bound (float32 intersection and storage: ~1e-6 measured).

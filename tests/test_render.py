@@ -237,3 +237,33 @@ def test_chessboard_corners_detected_at_truth(mi):
         err = d.min(axis=1)
         print(f"{view.name}: chessboard corner error max {err.max():.3f} px, rms {np.sqrt(np.mean(err**2)):.3f} px")
         assert err.max() < TOL_CHESSBOARD_PX, err.max()
+
+
+def test_envmap_top_row_is_world_up(mi, tmp_path):
+    """The spec's convention: an equirectangular map's top row is world +z (Mitsuba's is +y)."""
+    from scenegen import io as sio
+    from scenegen.render.scene import build_scene, render_view
+
+    env = np.zeros((32, 64, 3), np.float32)
+    env[:16] = (0.1, 0.2, 0.9)  # upper half: blue sky
+    env[16:] = (0.8, 0.3, 0.1)  # lower half: red ground
+    sio.write_exr(tmp_path / "env.exr", sio.pack_channels("", env, ("R", "G", "B")))
+    spec = parse_spec("""
+name: env
+lights:
+  - {type: envmap, path: env.exr}
+cameras:
+  cam: {size: [16, 12], fov_deg: 30}
+views:
+  - camera: cam
+    look_at:
+      - {eye: [0, 0, 0], target: [0.01, 0, 1], up: [1, 0, 0]}
+      - {eye: [0, 0, 0], target: [0.01, 0, -1], up: [1, 0, 0]}
+      - {eye: [0, 0, 0], target: [1, 0, 0.3]}
+""", file=str(tmp_path / "env.yaml"), base_dir=tmp_path)
+    built = build_scene(spec, spp=16, sampler="ldsampler", max_depth=2)
+    up, down, horizon = (render_view(built, "cam", v.cam_from_world, spp=16, seed=0) for v in resolve_views(spec))
+    np.testing.assert_allclose(up.mean(axis=(0, 1)), (0.1, 0.2, 0.9), atol=0.02)
+    np.testing.assert_allclose(down.mean(axis=(0, 1)), (0.8, 0.3, 0.1), atol=0.02)
+    # looking 17 degrees above the horizon: sky in the whole view (fov 30 deg horizontally)
+    assert horizon[:3].mean(axis=(0, 1))[2] > 0.8

@@ -234,6 +234,36 @@ CASES = [
     ("imaging_bad_white_balance",
      "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {white_balance: daylight}\n",
      5, "cameras.cam.imaging.white_balance", "expected one of 'auto'"),
+    # crossview (docs/crossview.md)
+    ("crossview_unknown_key_suggests",
+     CAM + "crossview:\n  pair: all\n",
+     4, "crossview.pair", "unknown key 'pair' (did you mean 'pairs'?)"),
+    ("crossview_bad_pair_mode",
+     CAM + "crossview: {pairs: every}\n",
+     3, "crossview.pairs", "expected one of 'consecutive', 'all', 'none'"),
+    ("crossview_pair_undefined_view",
+     CAM + "views:\n  - camera: cam\n    orbit: {radius_m: 2, count: 2}\ncrossview:\n"
+     "  pairs:\n    - [cam_0000, cam_0005]\n",
+     8, "crossview.pairs[0][1]", "undefined view 'cam_0005'"),
+    ("crossview_pair_same_view",
+     CAM + "views:\n  - camera: cam\n    orbit: {radius_m: 2, count: 2}\ncrossview:\n"
+     "  pairs: [[cam_0000, cam_0000]]\n",
+     7, "crossview.pairs[0][1]", "a pair needs two different views"),
+    ("crossview_pair_three_views",
+     CAM + "crossview:\n  pairs: [[a, b, c]]\n",
+     4, "crossview.pairs[0]", "expected a pair [view_a, view_b] of view names, got 3 items"),
+    ("crossview_outlier_fraction_one",
+     CAM + "crossview:\n  matches: {count: 10, outlier_fraction: 1.0}\n",
+     4, "crossview.matches.outlier_fraction", "expected a value >= 0 and < 1"),
+    ("crossview_near_miss_inverted",
+     CAM + "crossview:\n  matches:\n    near_miss_px: [10, 4]\n",
+     5, "crossview.matches.near_miss_px", "expected min <= max"),
+    ("crossview_flow_not_bool",
+     CAM + "crossview: {flow: maybe}\n",
+     3, "crossview.flow", "expected true or false"),
+    ("crossview_sift_inlier_px_zero",
+     CAM + "crossview: {sift: true, sift_inlier_px: 0}\n",
+     3, "crossview.sift_inlier_px", "expected a value > 0 (pixels)"),
 ]
 
 

@@ -27,23 +27,33 @@ def _mi():
 def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarray, np.ndarray]:
     """Distance (N,) float64 metres to the first surface along unit rays from ``origin_world``
     (3,) in directions (N, 3), and the hit points (N, 3) float64 (NaN on misses; t = +inf)."""
-    import drjit as dr
-
     mi = _mi()
     d = np.asarray(directions_world, np.float64)
     o = np.asarray(origin_world, np.float64)
     if len(d) == 0:
         return np.zeros(0), np.zeros((0, 3))
+    if mi.variant().startswith("scalar"):  # the slow fallback without a working libLLVM
+        t = np.array([float(scene.ray_intersect_preliminary(mi.Ray3f(mi.Point3f(*map(float, o)),
+                                                                     mi.Vector3f(*map(float, di)))).t)
+                      for di in d], dtype=np.float64)
+        t[~(t < np.inf)] = np.inf
+    else:
+        t = _first_hits_vectorised(mi, scene, o, d)
+    pts = o[None, :] + t[:, None] * d
+    pts[~np.isfinite(t)] = np.nan
+    return t, pts
+
+
+def _first_hits_vectorised(mi, scene, o, d) -> np.ndarray:
+    import drjit as dr
+
     ray = mi.Ray3f(mi.Point3f(*[float(c) for c in o]),
                    mi.Vector3f(d[:, 0].astype(np.float32), d[:, 1].astype(np.float32), d[:, 2].astype(np.float32)))
     si = scene.ray_intersect_preliminary(ray, coherent=False)
     hit = si.is_valid()
     t = dr.select(hit, si.t, dr.inf)
     dr.eval(t, hit)
-    t = np.array(t, dtype=np.float64)
-    pts = o[None, :] + t[:, None] * d
-    pts[~np.isfinite(t)] = np.nan
-    return t, pts
+    return np.array(t, dtype=np.float64)
 
 
 def visible_from(scene, center_world, points_world, rel_tol: float = OCCLUSION_REL_TOL) -> np.ndarray:

@@ -3,7 +3,12 @@
 
 Only views that are complete in the dataset take part (a ``--frames`` run covers the pairs it
 has). Each view's truth points are recomputed in float64 by the truth pass (one ray cast per
-pixel, milliseconds), so resumed runs give the same bytes. File layout: docs/crossview.md.
+pixel, milliseconds; the same call as the stored truth), so resumed runs give the same bytes.
+Views are projected into each other with their mid-exposure poses (the scene is at
+mid-exposure, as for the truth): for a moving camera with a rolling shutter, i's points follow
+its per-row poses but j is projected as a global shutter at its mid-exposure pose. Rectified
+stereo views are ideal pinholes: no lens blur, motion or chromatic aberration, and the
+pipeline's clean sRGB encoding. File layout: docs/crossview.md.
 """
 from __future__ import annotations
 
@@ -119,8 +124,12 @@ class _Context:
     def points(self, name) -> np.ndarray:
         """(H, W, 3) float64 world truth points of a view (NaN = no surface)."""
         if name not in self._points:
+            from scenegen.pipeline import rolling_shutter_rows
+
             cam, pose = self.camera(name)
-            t = self._truth_pass(self.built.scene, cam, pose, self.built.id_tables)
+            # the same call as the view's stored truth (per-row poses for a rolling shutter)
+            t = self._truth_pass(self.built.scene, cam, pose, self.built.id_tables,
+                                 row_poses=rolling_shutter_rows(self.built, self.views[name]))
             self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
         return self._points[name]
 

@@ -13,8 +13,22 @@ from scenegen.crossview.correspondence import OCCLUDED, OUT_OF_FRAME, VISIBLE, i
 
 
 def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn) -> dict:
-    """JSON-ready truth of one board in one view (see the module docstring)."""
-    P = world_from_board.apply(np.asarray(board.points_board, np.float64))
+    """JSON-ready truth of one board in one view (see the module docstring). ChArUco boards also
+    get their markers' corners (``marker_ids``, ``marker_corners`` with the same fields, (M, 4)
+    in OpenCV's corner order)."""
+    out = _points_truth(np.asarray(board.points_board, np.float64), world_from_board, camera, cam_from_world,
+                        visible_fn)
+    out = {"kind": board.kind, "point_ids": np.asarray(board.point_ids).tolist(), **out}
+    if board.kind == "charuco" and len(board.marker_ids):
+        mc = _points_truth(np.asarray(board.marker_corners_board, np.float64).reshape(-1, 3), world_from_board,
+                           camera, cam_from_world, visible_fn)
+        out["marker_ids"] = np.asarray(board.marker_ids).tolist()
+        out["marker_corners"] = {k: [v[i:i + 4] for i in range(0, len(v), 4)] for k, v in mc.items()}
+    return out
+
+
+def _points_truth(points_board, world_from_board, camera, cam_from_world, visible_fn) -> dict:
+    P = world_from_board.apply(points_board)
     uv, z, valid = project_points(P, camera, cam_from_world)
     inside = valid & in_frame(uv, camera)
     C = cam_from_world.inverse().t
@@ -24,7 +38,6 @@ def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn
     cand = np.flatnonzero(inside)
     vis = np.asarray(visible_fn(C, P[cand]), bool) & facing[cand]
     state[cand] = np.where(vis, VISIBLE, OCCLUDED)
-    return {"kind": board.kind, "point_ids": np.asarray(board.point_ids).tolist(),
-            "points_world": P.tolist(),
+    return {"points_world": P.tolist(),
             "uv": [[float(a), float(b)] if np.isfinite(a) else None for a, b in uv],
             "depth_z": [float(x) for x in z], "state": state.tolist(), "facing": facing.tolist()}

@@ -99,6 +99,8 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         "views": views,
         # only when declared, so that specs without variation keep their hashes
         **({"variation": _plain(spec.variation)} if spec.variation is not None else {}),
+        # likewise the cross-view outputs: their settings are part of the run's identity
+        **({"crossview": _plain(spec.crossview)} if getattr(spec, "crossview", None) is not None else {}),
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
     }
 

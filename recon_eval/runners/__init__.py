@@ -1,0 +1,100 @@
+"""Runs of third-party estimators on scenegen datasets, scored with recon_eval's metrics.
+
+One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fisheye),
+:mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
+findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
+SfM), :mod:`.broken` (deliberately wrong estimators that gates must catch).
+
+:func:`run_method` runs one registered method and writes ``OUT/result.json`` (the run-result
+JSON, ``command: "run"``, docs/ci.md) next to the raw outputs.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+
+from recon_eval.runners._common import RUN_SCHEMA_VERSION, NotApplicable, RunOutput, Timer, scene_name
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    module: str  # recon_eval.runners.<module>
+    function: str
+    description: str
+    options: tuple = ()  # (key, value) pairs passed to the function
+
+
+def _m(name, module, function, description, **options):
+    return Method(name, module, function, description, tuple(sorted(options.items())))
+
+
+_F = ("7point", "8point", "ransac", "lmeds", "usac_default", "usac_parallel", "usac_fm_8pts", "usac_fast",
+      "usac_accurate", "usac_prosac", "usac_magsac")
+
+METHODS: dict[str, Method] = {m.name: m for m in [
+    _m("opencv-calib-checkerboard", "calibration", "checkerboard",
+       "cv2.calibrateCamera on findChessboardCorners + cornerSubPix (k1 k2 p1 p2 k3)"),
+    _m("opencv-calib-charuco", "calibration", "charuco", "cv2.calibrateCamera on CharucoDetector corners"),
+    _m("opencv-calib-fisheye", "calibration", "fisheye", "cv2.fisheye.calibrate on checkerboard corners"),
+    _m("opencv-stereo-bm", "stereo", "run", "cv2.StereoBM on the rectified pairs", matcher="bm"),
+    _m("opencv-stereo-sgbm", "stereo", "run", "cv2.StereoSGBM (3-way) on the rectified pairs", matcher="sgbm"),
+    *[_m(f"opencv-f-{f.replace('_', '-')}", "twoview", "fundamental", f"cv2.findFundamentalMat {f}", flag=f)
+      for f in _F],
+    _m("opencv-e-ransac", "twoview", "essential", "cv2.findEssentialMat RANSAC", flag="ransac"),
+    _m("opencv-e-lmeds", "twoview", "essential", "cv2.findEssentialMat LMEDS", flag="lmeds"),
+    _m("opencv-e-usac-magsac", "twoview", "essential", "cv2.findEssentialMat USAC_MAGSAC", flag="usac_magsac"),
+    _m("opencv-h-ransac", "twoview", "homography", "cv2.findHomography RANSAC on one plane's matches", flag="ransac"),
+    _m("opencv-h-usac-magsac", "twoview", "homography", "cv2.findHomography USAC_MAGSAC", flag="usac_magsac"),
+    *[_m(f"opencv-pnp-{s}", "pnp", "run", f"cv2.solvePnP SOLVEPNP_{s.upper()}", solver=s, ransac=False)
+      for s in ("iterative", "epnp", "sqpnp", "ippe", "ap3p")],
+    *[_m(f"opencv-pnp-ransac-{s}", "pnp", "run", f"cv2.solvePnPRansac SOLVEPNP_{s.upper()}", solver=s, ransac=True)
+      for s in ("iterative", "epnp", "sqpnp", "ap3p")],
+    _m("pycolmap-incremental", "colmap", "incremental",
+       "pycolmap extract_features + match_exhaustive + incremental_mapping"),
+    _m("broken-calib-cx", "calibration", "broken_cx", "DELIBERATELY BROKEN: checkerboard calibration, cx + 2 px"),
+    _m("broken-f-transposed", "twoview", "fundamental", "DELIBERATELY BROKEN: RANSAC F, transposed",
+       flag="ransac", transpose=True),
+]}
+
+
+def method(name: str) -> Method:
+    from recon_eval.errors import InputError
+    from difflib import get_close_matches
+
+    if name not in METHODS:
+        close = get_close_matches(name, list(METHODS), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}")
+    return METHODS[name]
+
+
+def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
+    """Run method ``name`` on the dataset folder ``dataset``; raw outputs and ``result.json`` go to
+    ``out_dir``. Returns the result document. Raises InputError (NotApplicable when the dataset
+    lacks what the method needs)."""
+    import cv2
+
+    from recon_eval.readers.scenegen_dataset import read_dataset
+    from recon_eval.report import document, to_jsonable, write_json_atomic
+
+    m = method(name)
+    ds = read_dataset(dataset)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fn = getattr(importlib.import_module(f"recon_eval.runners.{m.module}"), m.function)
+    with Timer() as t:
+        res: RunOutput = fn(ds, out, dict(m.options))
+    inputs = {"method": m.name, "description": m.description, "options": dict(m.options),
+              "dataset": str(dataset), "scene": scene_name(ds), "raw_files": res.raw_files,
+              "notes": res.notes, "seconds": t.s, "opencv_version": cv2.__version__,
+              "run_schema_version": RUN_SCHEMA_VERSION}
+    doc = document("run", inputs, res.results)
+    doc["metrics"] = to_jsonable(res.metrics)
+    if write:
+        write_json_atomic(out / "result.json", doc)
+    return doc
+
+
+__all__ = ["METHODS", "Method", "NotApplicable", "RunOutput", "method", "run_method"]

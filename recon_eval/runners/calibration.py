@@ -1,0 +1,185 @@
+"""OpenCV camera calibration on the dataset's board views: ``cv2.calibrateCamera`` on
+checkerboard corners (``findChessboardCorners`` + ``cornerSubPix``) or ChArUco corners
+(``cv2.aruco.CharucoDetector``), and ``cv2.fisheye.calibrate`` on checkerboard corners.
+
+Raw output: ``calibration_<camera>.yaml`` (cv2.FileStorage, the fields OpenCV's calibration sample
+writes: image size, camera_matrix, distortion_coefficients, distortion_model, avg_reprojection_error,
+per-view errors, flags). Scores (recon_eval.calibration, metrics.md "Calibration and PnP"):
+fx/fy/cx/cy errors, the projection-difference field (intrinsics only, mrcal's
+``intrinsics_only``), and the reprojection RMS of held-out truth points at the truth pose of the
+first calibrated view.
+
+Object points are the board truth of ``scene/targets/<board>.json`` (metres, board frame). A
+checkerboard detection may come back in reverse order (the pattern is symmetric under a half turn
+for the detector); that swaps the per-view extrinsics, never the intrinsics.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from recon_eval.runners._common import NotApplicable, RunOutput, boards, gray, out_path
+
+#: cornerSubPix half window, px: a quarter of the smallest square the scene library shows
+#: (~20 px at 480x360), so the window never reaches the next corner.
+SUBPIX_HALF_WINDOW_PX = 5
+#: cornerSubPix stop: 100 iterations or a 1e-4 px step (far below the 0.01 px level that matters).
+SUBPIX_CRITERIA = (3, 100, 1e-4)  # cv2.TERM_CRITERIA_EPS + MAX_ITER
+#: Held-out truth points per calibration for the reprojection RMS.
+HELD_OUT_POINTS = 5000
+
+
+def _camera_groups(ds) -> dict:
+    """spec camera name -> its complete views, in view order."""
+    out: dict = {}
+    for v in ds.views:
+        out.setdefault(ds.view_info(v).get("camera_name"), []).append(v)
+    return out
+
+
+def _checkerboard_detections(ds, views, geo, truth):
+    import cv2
+
+    pattern = (int(geo["inner_cols"]), int(geo["inner_rows"]))
+    obj = np.asarray(truth["points_board"], np.float64)
+    used, objs, imgs = [], [], []
+    for v in views:
+        g = gray(ds.image(v))
+        ok, c = cv2.findChessboardCorners(g, pattern, cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE)
+        if not ok:
+            continue
+        w = SUBPIX_HALF_WINDOW_PX
+        c = cv2.cornerSubPix(g, c, (w, w), (-1, -1), SUBPIX_CRITERIA)
+        used.append(v)
+        objs.append(obj.astype(np.float32).reshape(-1, 1, 3))
+        imgs.append(c.astype(np.float32).reshape(-1, 1, 2))
+    return used, objs, imgs
+
+
+def _charuco_detections(ds, views, geo, truth):
+    import cv2
+
+    d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, geo["dictionary"]))
+    board = cv2.aruco.CharucoBoard((int(geo["squares_x"]), int(geo["squares_y"])), float(geo["square_m"]),
+                                   float(geo["marker_m"]), d)
+    det = cv2.aruco.CharucoDetector(board)
+    pts = np.asarray(truth["points_board"], np.float64)
+    ids_truth = list(truth["point_ids"])
+    used, objs, imgs = [], [], []
+    for v in views:
+        corners, ids, _, _ = det.detectBoard(gray(ds.image(v)))
+        if ids is None or len(ids) < 6:  # calibrateCamera needs >= 4 non-collinear; 6 for a stable view
+            continue
+        idx = [ids_truth.index(int(i)) for i in ids.ravel()]
+        used.append(v)
+        objs.append(pts[idx].astype(np.float32).reshape(-1, 1, 3))
+        imgs.append(np.asarray(corners, np.float32).reshape(-1, 1, 2))
+    return used, objs, imgs
+
+
+def _write_yaml(path, width, height, K, D, model, rms, per_view, views, flags, board_name):
+    import cv2
+
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    fs.write("image_width", int(width))
+    fs.write("image_height", int(height))
+    fs.write("camera_matrix", np.asarray(K, np.float64))
+    fs.write("distortion_coefficients", np.asarray(D, np.float64).reshape(1, -1))
+    fs.write("distortion_model", "equidistant" if model == "fisheye" else "plumb_bob")
+    fs.write("avg_reprojection_error", float(rms))
+    fs.write("per_view_reprojection_errors", np.asarray(per_view, np.float64).reshape(-1, 1))
+    fs.write("nr_of_frames", len(views))
+    fs.write("flags", int(flags))
+    fs.write("board", board_name)
+    fs.release()
+
+
+def _score(ds, out: RunOutput, key: str, pre: str, yaml_path, views_used, views_all, rms):
+    from recon_eval.calibration import intrinsics_errors, projection_difference, reprojection_rms
+    from recon_eval.readers.opencv_calib import read_opencv_calibration
+
+    est = read_opencv_calibration(yaml_path)  # score what was written
+    gt, pose = ds.camera(views_used[0])
+    uv, X = ds.points_at_pixels(views_used[0], max_points=HELD_OUT_POINTS)
+    ie = intrinsics_errors(est.K, gt.K)
+    pdiff = projection_difference(gt, est)
+    rep = reprojection_rms(est, pose.R, pose.t, X, uv)
+    out.results[f"{key}.intrinsics"] = ie
+    out.results[f"{key}.projection_diff"] = pdiff
+    out.results[f"{key}.reprojection_held_out"] = rep
+    m = out.metrics
+    m[pre + "fx_rel_err"] = ie.fx_rel_err
+    m[pre + "fy_rel_err"] = ie.fy_rel_err
+    m[pre + "cx_abs_err_px"] = ie.cx_abs_err_px
+    m[pre + "cy_abs_err_px"] = ie.cy_abs_err_px
+    m[pre + "proj_diff_rms_px"] = pdiff.rms_px
+    m[pre + "proj_diff_max_px"] = pdiff.max_px
+    m[pre + "held_out_reproj_rms_px"] = rep.rms_px
+    m[pre + "calib_rms_px"] = float(rms)
+    m[pre + "views_used_ratio"] = len(views_used) / len(views_all)
+
+
+def _calibrate(ds, out_dir, *, board_kind: str, fisheye: bool, perturb_cx_px: float = 0.0) -> RunOutput:
+    import cv2
+
+    bs = {n: b for n, b in boards(ds).items() if b[0]["kind"] == board_kind}
+    if not bs:
+        raise NotApplicable(f"{ds.root}: the scene has no {board_kind} board")
+    board_name, (geo, truth) = next(iter(bs.items()))
+    out = RunOutput()
+    out.notes["board"] = board_name
+    groups = _camera_groups(ds)
+    for cam_name, views in groups.items():
+        pre = "" if len(groups) == 1 else f"{cam_name}."  # metric names carry the camera when several
+        cam0, _ = ds.camera(views[0])
+        if fisheye != (cam0.model == "fisheye"):
+            continue
+        detect = _checkerboard_detections if board_kind == "checkerboard" else _charuco_detections
+        used, objs, imgs = detect(ds, views, geo, truth)
+        size = (cam0.width, cam0.height)
+        if len(used) < 3:
+            out.notes[f"{cam_name}.failed"] = f"board found in {len(used)} of {len(views)} views (< 3)"
+            out.metrics[pre + "views_used_ratio"] = len(used) / len(views)
+            continue
+        if fisheye:
+            flags = cv2.fisheye.CALIB_RECOMPUTE_EXTRINSIC | cv2.fisheye.CALIB_FIX_SKEW
+            crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-12)
+            rms, K, D, rv, tv = cv2.fisheye.calibrate([o.reshape(1, -1, 3).astype(np.float64) for o in objs],
+                                                      [i.reshape(1, -1, 2).astype(np.float64) for i in imgs],
+                                                      size, None, None, flags=flags, criteria=crit)
+            per_view = []
+            for o, i, r, t in zip(objs, imgs, rv, tv):
+                p, _ = cv2.fisheye.projectPoints(o.reshape(1, -1, 3).astype(np.float64), r, t, K, D)
+                per_view.append(float(np.sqrt(np.mean(np.sum((p.reshape(-1, 2) - i.reshape(-1, 2)) ** 2, 1)))))
+        else:
+            flags = 0
+            crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-12)
+            rms, K, D, rv, tv, _, _, per_view = cv2.calibrateCameraExtended(objs, imgs, size, None, None,
+                                                                           flags=flags, criteria=crit)
+        K = np.array(K, np.float64)
+        K[0, 2] += perturb_cx_px  # only the deliberately broken variant sets this
+        path = out_path(out_dir, f"calibration_{cam_name}.yaml")
+        _write_yaml(path, *size, K, D, "fisheye" if fisheye else "opencv", rms, per_view, used, flags, board_name)
+        out.raw_files.append(path.name)
+        out.notes[f"{cam_name}.views_used"] = used
+        _score(ds, out, cam_name, pre, path, used, views, rms)
+    if not out.raw_files and not out.metrics:
+        raise NotApplicable(f"{ds.root}: no {'fisheye' if fisheye else 'OpenCV/pinhole'} camera sees the {board_kind} board")
+    return out
+
+
+def checkerboard(ds, out_dir, options=None) -> RunOutput:
+    return _calibrate(ds, out_dir, board_kind="checkerboard", fisheye=False)
+
+
+def charuco(ds, out_dir, options=None) -> RunOutput:
+    return _calibrate(ds, out_dir, board_kind="charuco", fisheye=False)
+
+
+def fisheye(ds, out_dir, options=None) -> RunOutput:
+    return _calibrate(ds, out_dir, board_kind="checkerboard", fisheye=True)
+
+
+def broken_cx(ds, out_dir, options=None) -> RunOutput:
+    """A deliberately broken estimator for gate tests: checkerboard calibration whose written
+    camera matrix has cx moved by +2 px."""
+    return _calibrate(ds, out_dir, board_kind="checkerboard", fisheye=False, perturb_cx_px=2.0)

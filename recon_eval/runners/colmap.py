@@ -1,0 +1,84 @@
+"""pycolmap incremental SfM on a dataset's views: SIFT extraction (one shared camera per
+spec camera, COLMAP's SIMPLE_RADIAL model initialised from its default focal guess: no truth
+intrinsics), exhaustive matching, incremental mapping. CPU only.
+
+Raw output: ``colmap/database.db`` and the largest model ``colmap/sparse/`` (COLMAP binary).
+Scores (recon_eval.poses): APE after Sim(3) Umeyama alignment on the camera centres (rotation
+error per camera, translation error in metres), registration ratio (an unregistered view is a
+failure with error inf, never dropped), and the sparse cloud mapped by the same Sim(3) into the
+world frame and scored against the scene meshes (point-to-triangle, Chamfer and the fraction
+within TAU_M).
+"""
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+
+from recon_eval.runners._common import NotApplicable, RunOutput, out_path
+
+#: Distance threshold of the sparse-cloud accuracy, metres (Tanks-and-Temples-style precision).
+TAU_M = 0.01
+#: SIFT features per image (COLMAP's default is 8192; the library scenes are small images).
+MAX_FEATURES = 4096
+
+
+def incremental(ds, out_dir, options) -> RunOutput:
+    import pycolmap
+
+    from recon_eval.align import Alignment
+    from recon_eval.pointcloud import chamfer, tanks_and_temples
+    from recon_eval.poses import ape, registration_ratio
+    from recon_eval.readers.colmap_binary import read_colmap_binary
+
+    if len(ds.views) < 3:
+        raise NotApplicable(f"{ds.root}: SfM needs at least 3 views, the dataset has {len(ds.views)}")
+    work = out_path(out_dir, "colmap/images")
+    shutil.rmtree(work.parent, ignore_errors=True)
+    work.mkdir(parents=True)
+    for v in ds.views:
+        shutil.copy(ds.root / "images" / f"{v}.png", work / f"{v}.png")
+    db = work.parent / "database.db"
+    ext = pycolmap.FeatureExtractionOptions()
+    ext.sift.max_num_features = MAX_FEATURES
+    pycolmap.extract_features(db, work, camera_mode=pycolmap.CameraMode.SINGLE, extraction_options=ext,
+                              device=pycolmap.Device.cpu)
+    pycolmap.match_exhaustive(db, device=pycolmap.Device.cpu)
+    sparse = work.parent / "sparse_all"
+    recs = pycolmap.incremental_mapping(db, work, sparse)
+    out = RunOutput()
+    if not recs:
+        out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
+        out.notes["failed"] = "no reconstruction"
+        return out
+    best = max(recs.values(), key=lambda r: r.num_reg_images())
+    model = work.parent / "sparse"
+    model.mkdir(exist_ok=True)
+    best.write_binary(str(model))
+    out.raw_files += ["colmap/database.db", "colmap/sparse/cameras.bin", "colmap/sparse/images.bin",
+                      "colmap/sparse/points3D.bin"]
+    shutil.rmtree(sparse, ignore_errors=True)
+    shutil.rmtree(work, ignore_errors=True)  # the copies of the images
+    est_model = read_colmap_binary(model)  # score what was written
+    from recon_eval.poses import Poses
+
+    est = est_model.poses
+    names = tuple(n.rsplit(".", 1)[0] for n in est.names)
+    est = Poses(names, est.R_cam_from_world, est.t_cam_from_world)
+    gt = ds.poses
+    a = ape(est, gt, alignment=Alignment.SIM3)
+    out.results["ape_sim3"] = a
+    rr = registration_ratio(est, gt)
+    rot = np.asarray(a.rot_err_deg, float)
+    out.metrics.update({"registration_ratio": rr, "max_rot_err_deg": float(np.max(rot)),
+                        "median_rot_err_deg": float(np.median(rot)), "n_points3d": int(best.num_points3D())})
+    pts = np.asarray(est_model.points_world, float).reshape(-1, 3)
+    if len(pts):
+        pw = a.tgt_from_src.apply(pts)
+        V, F = ds.mesh()
+        tt = tanks_and_temples(pw, V, TAU_M, gt_mesh=(V, F), downsample=False)
+        ch = chamfer(pw, V, gt_mesh=(V, F))
+        out.results["sparse_cloud"] = {"tanks_and_temples_precision_at_tau": tt.precision, "tau_m": TAU_M,
+                                       "chamfer": ch}
+        out.metrics["cloud_precision_at_1cm"] = tt.precision
+    return out
