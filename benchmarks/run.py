@@ -15,4 +15,10 @@ if __name__ == "__main__":
     for script in ("bench_render.py", "bench_fscore.py", "bench_scale.py"):
         print(f"== {script}", flush=True)
         failed |= subprocess.call([sys.executable, str(HERE / script)])
+    # Cycles comparison: only where its optional bpy environment exists (bench_cycles.py --setup)
+    if (HERE / ".venv-bpy" / "bin" / "python").is_file():
+        print("== bench_cycles.py", flush=True)
+        failed |= subprocess.call([sys.executable, str(HERE / "bench_cycles.py")])
+    else:
+        print("== bench_cycles.py: skipped (no benchmarks/.venv-bpy; run bench_cycles.py --setup)")
     sys.exit(failed)

@@ -452,14 +452,14 @@ class Camera:
     def _fold_limit(self) -> float:
         """The monotonic region: r^2 limit (opencv), theta limit (fisheye), inf (pinhole).
 
-        Searches along 180 directions for the first radius where the distortion's Jacobian
+        Searches along 120 directions (1500 radii each, 0.06 degree steps) for the first radius where the distortion's Jacobian
         determinant is <= 0; if that fold lands at a pixel inside the image, the camera is
         rejected.
         """
         if self.model == "pinhole":
             return math.inf
         p = self._raw_params()
-        phi = np.linspace(0.0, 2 * np.pi, 180, endpoint=False)[:, None]
+        phi = np.linspace(0.0, 2 * np.pi, 120, endpoint=False)[:, None]
         if self.model == "fisheye":
             theta = np.linspace(0.0, np.pi, 4001)[1:]
             dth = fisheye_dtheta_d(theta, p)
@@ -471,7 +471,7 @@ class Camera:
             xd, yd = td * np.cos(phi[:, 0]), td * np.sin(phi[:, 0])
             self._reject_if_inside(xd, yd, p, f"theta = {math.degrees(t_fold):.2f} deg")
             return float(theta[fold[0] - 1]) if fold[0] > 0 else 0.0
-        ang = np.radians(np.linspace(0.0, _MAX_PERSPECTIVE_ANGLE_DEG, 3001)[1:])[None, :]
+        ang = np.radians(np.linspace(0.0, _MAX_PERSPECTIVE_ANGLE_DEG, 1501)[1:])[None, :]
         r = np.tan(ang)
         x, y = r * np.cos(phi), r * np.sin(phi)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):

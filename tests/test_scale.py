@@ -216,12 +216,16 @@ def _complete_views(out: Path) -> int:
 
 
 def _run_and_kill(spec: Path, out: Path, *, resume: bool, after_s: float | None = None,
-                  after_views: int | None = None) -> int:
-    """Start `scenegen render`, SIGKILL it at the given point; returns views complete then."""
-    cmd = [sys.executable, "-m", "scenegen.cli", "render", str(spec), "-o", str(out), "-q"]
+                  after_views: int | None = None, extra=()) -> int:
+    """Start `scenegen render`, SIGKILL it at the given point; returns views complete then.
+    Its child processes (Dask workers) must end with it."""
+    import psutil
+
+    cmd = [sys.executable, "-m", "scenegen.cli", "render", str(spec), "-o", str(out), "-q", *extra]
     proc = subprocess.Popen(cmd + (["--resume"] if resume else []), stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     t0 = time.monotonic()
+    children = []
     try:
         while proc.poll() is None and time.monotonic() - t0 < 120:
             if after_s is not None and time.monotonic() - t0 >= after_s:
@@ -230,23 +234,28 @@ def _run_and_kill(spec: Path, out: Path, *, resume: bool, after_s: float | None 
                 break
             time.sleep(0.005)
         assert proc.poll() is None, "the run finished before it could be killed"
+        children = psutil.Process(proc.pid).children(recursive=True)
         proc.send_signal(signal.SIGKILL)
     finally:
         proc.wait()
     assert proc.returncode == -signal.SIGKILL
+    _, alive = psutil.wait_procs(children, timeout=30)
+    assert not alive, f"worker processes outlived the killed run: {alive}"
     return _complete_views(out)
 
 
 def test_sigkill_at_several_points_then_resume_gives_the_uninterrupted_dataset(tmp_path):
     from scenegen.pipeline import render_spec
 
-    spec = _write(tmp_path, "frames.yaml", FRAMES.replace("NFRAMES", "6"))
+    spec = _write(tmp_path, "frames.yaml", FRAMES.replace("NFRAMES", "10"))
     ref, out = tmp_path / "ref", tmp_path / "out"
     render_spec(spec, ref, progress=False)
     done = [_run_and_kill(spec, out, resume=False, after_s=0.3)]  # while starting up
     done.append(_run_and_kill(spec, out, resume=True, after_views=1))
     done.append(_run_and_kill(spec, out, resume=True, after_views=done[-1] + 3))
-    assert done[0] == 0 and 1 <= done[1] < done[2] < 12
+    # a distributed run resumes a serial one, is killed in turn, and a serial run finishes it
+    done.append(_run_and_kill(spec, out, resume=True, after_views=done[-1] + 2, extra=("--workers", "2")))
+    assert done[0] == 0 and 1 <= done[1] < done[2] < done[3] < 20
     assert not verify(out).ok  # interrupted: incomplete views (and maybe unrecorded files)
     assert main(["render", str(spec), "-o", str(out), "-q", "--resume"]) == 0
     assert (out / "manifest.json").read_bytes() == (ref / "manifest.json").read_bytes()

@@ -1,0 +1,153 @@
+"""Mitsuba (this project) vs Blender Cycles (`bpy`, the renderer Kubric uses) on the same picture.
+
+The same meshes (a textured blob and a textured floor, world-frame triangles with the same UVs
+and vertex normals), the same textures (linear, bilinear, repeating), the same light (a uniform
+environment of radiance 1: exact in both renderers' units), the same pinhole camera, resolution,
+samples per pixel, path depth and box filter, no denoising, 2 threads each, both warm. Reports the
+warm time ratio and the image difference next to Mitsuba's own seed-to-seed noise, so that it is
+clear the comparison is of the same picture.
+
+bpy is big and optional: it lives only in its own environment, never in .venv or pyproject.
+    .venv/bin/python benchmarks/bench_cycles.py --setup      # creates benchmarks/.venv-bpy (bpy==5.0.1)
+    .venv/bin/python benchmarks/bench_cycles.py [--size 320 240] [--spp 64]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+BPY_VENV = HERE / ".venv-bpy"
+BPY_PIN = "bpy==5.0.1"  # Blender 5.0.1; wheels for CPython 3.11
+
+SPEC = """
+name: cycles_cmp
+render: {{spp: {spp}, max_depth: {depth}, sampler: ldsampler}}
+objects:
+  - name: floor
+    shape: {{type: plane, size: [4, 4]}}
+    material: {{type: diffuse, texture: {{type: checkerboard, params: {{squares_u: 8, squares_v: 8}}}}}}
+  - name: rock
+    shape: {{type: blob, radius: 0.5, subdivisions: 5}}
+    transform: {{translation: [0, 0, 0.5]}}
+    material: {{type: diffuse, texture: {{type: noise, params: {{size_px: 256}}}}}}
+lights:
+  - {{type: constant, radiance: 1.0}}
+cameras:
+  cam: {{model: pinhole, size: [{w}, {h}], fx: {f}, fy: {f}, cx: {cx}, cy: {cy}}}
+views:
+  - camera: cam
+    look_at: [{{eye: [2.2, -2.2, 1.6], target: [0, 0, 0.4]}}]
+"""
+
+
+def setup() -> int:
+    if not (BPY_VENV / "bin" / "python").is_file():
+        subprocess.check_call([sys.executable, "-m", "venv", str(BPY_VENV)])
+    return subprocess.call([str(BPY_VENV / "bin" / "python"), "-m", "pip", "install", BPY_PIN, "numpy"])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--setup", action="store_true", help=f"create {BPY_VENV} with {BPY_PIN}")
+    ap.add_argument("--size", type=int, nargs=2, default=(320, 240))
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--max-depth", type=int, default=3, help="Mitsuba path depth (Cycles bounces = depth - 2)")
+    ap.add_argument("--keep", metavar="DIR", help="save both images there as .npy")
+    args = ap.parse_args(argv)
+    if args.setup:
+        return setup()
+    py = BPY_VENV / "bin" / "python"
+    if not py.is_file():
+        print(f"no bpy environment: run {Path(__file__).name} --setup first (installs {BPY_PIN} into {BPY_VENV})")
+        return 2
+
+    from scenegen.render.backend import load_mitsuba
+
+    mi = load_mitsuba("auto")
+    import drjit as dr
+
+    from scenegen import io as sio
+    from scenegen.conventions import blender_matrix_world
+    from scenegen.render.scene import build_scene, render_view, texture_image
+    from scenegen.spec import parse_spec, resolve_views
+
+    W, H = args.size
+    f = 0.9 * W
+    spec = parse_spec(SPEC.format(spp=args.spp, depth=args.max_depth, w=W, h=H, f=f, cx=(W - 1) / 2,
+                                  cy=(H - 1) / 2), file="bench_cycles")
+    view = resolve_views(spec)[0]
+    built = build_scene(spec, spp=args.spp, sampler="ldsampler", max_depth=args.max_depth)
+    dr.set_thread_count(2)
+    render = lambda seed: render_view(built, "cam", view.cam_from_world, spp=args.spp, seed=seed)
+    t = time.perf_counter()
+    render(1)
+    mi_cold = time.perf_counter() - t
+    times = []
+    for s in (2, 3):
+        t = time.perf_counter()
+        render(s)
+        times.append(time.perf_counter() - t)
+    mi_warm = min(times)
+    img_a, img_b = render(11), render(12)  # two seeds: Mitsuba's own noise
+
+    with tempfile.TemporaryDirectory() as tmp:
+        data = {"settings": np.array([W, H, args.spp, args.max_depth - 2, 2]), "env_radiance": np.array(1.0),
+                "focal_px": np.array(f), "blender_matrix_world": blender_matrix_world(view.cam_from_world),
+                "objects": np.array([o.name for o in spec.objects])}
+        for o in spec.objects:
+            mesh = built.meshes_world[o.name]
+            data[f"{o.name}.vertices"] = np.asarray(mesh.vertices, np.float64)
+            data[f"{o.name}.faces"] = np.asarray(mesh.faces, np.int64)
+            data[f"{o.name}.uv"] = np.asarray(mesh.visual.uv, np.float64)
+            if o.name == "rock":  # smooth-shaded in Mitsuba with these vertex normals
+                data[f"{o.name}.normals"] = np.asarray(mesh.vertex_normals, np.float64)
+            tex = np.asarray(texture_image(o.material.texture), np.float32)  # (h, w, 3), row 0 = top
+            tex_path = Path(tmp) / f"{o.name}.exr"
+            tex_path.write_bytes(sio.encode_exr(sio.pack_channels("", tex, ("R", "G", "B"))))
+            data[f"{o.name}.texture_exr"] = np.array(str(tex_path))
+        npz, exr = Path(tmp) / "scene.npz", Path(tmp) / "cycles.exr"
+        np.savez(npz, **data)
+        if args.keep:
+            np.savez(Path(args.keep) / "scene.npz", **data)
+        r = subprocess.run([str(py), str(HERE / "_cycles_render.py"), str(npz), str(exr)],
+                           capture_output=True, text=True)
+        line = next((ln for ln in r.stdout.splitlines() if ln.startswith("CYCLES_TIMES ")), None)
+        if r.returncode != 0 or line is None:
+            print(r.stdout[-3000:], r.stderr[-3000:])
+            return 1
+        cy = json.loads(line.split(" ", 1)[1])
+
+        ch = sio.read_exr(exr)
+        img_c = np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float64)
+
+    a, b, c = (np.asarray(x, np.float64) for x in (img_a, img_b, img_c))
+    if args.keep:
+        np.save(Path(args.keep) / "mitsuba.npy", a)
+        np.save(Path(args.keep) / "cycles.npy", c)
+    scale = np.mean(a)
+
+    def rel_mad(x, y):
+        return float(np.mean(np.abs(x - y)) / scale)
+
+    print(f"Mitsuba {mi.variant()} vs Cycles {cy['version']}: {W}x{H}, {args.spp} spp, path depth "
+          f"{args.max_depth} (Cycles bounces {args.max_depth - 2}), box filter, 2 threads, no denoising")
+    print(f"  warm time: Mitsuba {mi_warm:.3f} s, Cycles {cy['warm_s']:.3f} s -> Cycles / Mitsuba = "
+          f"{cy['warm_s'] / mi_warm:.2f} (cold: {mi_cold:.2f} s vs {cy['cold_s']:.2f} s)")
+    print(f"  mean image value: Mitsuba {np.mean(a):.4f}, Cycles {np.mean(c):.4f} (ratio {np.mean(c) / np.mean(a):.4f})")
+    print(f"  relative MAD: Mitsuba seed vs seed {rel_mad(a, b):.4f}; Mitsuba vs Cycles {rel_mad(a, c):.4f}")
+    blur = lambda x: x.reshape(H // 8, 8, W // 8, 8, 3).mean(axis=(1, 3))  # 8x8 means: noise averages out
+    print(f"  8x8-block relative MAD (bias, not noise): seed vs seed {rel_mad(blur(a), blur(b)):.4f}; "
+          f"Mitsuba vs Cycles {rel_mad(blur(a), blur(c)):.4f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
