@@ -39,35 +39,39 @@ MITSUBA_FROM_OPENCV_CAM = np.diag([-1.0, -1.0, 1.0])
 OPENGL_FROM_OPENCV_CAM = np.diag([1.0, -1.0, -1.0])
 
 
-def mitsuba_to_world(cam_from_world: Rigid3) -> np.ndarray:
-    """Mitsuba sensor ``to_world`` (4x4, Mitsuba camera -> world) for an OpenCV ``cam_from_world``."""
+def _camera_to_world(cam_from_world: Rigid3, foreign_from_opencv: np.ndarray) -> np.ndarray:
+    """4x4 camera-to-world of a camera frame with other axes (x_foreign = A x_opencv)."""
     world_from_cam = cam_from_world.inverse()
     T = np.eye(4)
-    T[:3, :3] = world_from_cam.R @ MITSUBA_FROM_OPENCV_CAM.T
+    T[:3, :3] = world_from_cam.R @ foreign_from_opencv.T
     T[:3, 3] = world_from_cam.t
     return T
 
 
+def _cam_from_world(camera_to_world, foreign_from_opencv: np.ndarray) -> Rigid3:
+    T = np.asarray(camera_to_world, dtype=np.float64)
+    return Rigid3(T[:3, :3] @ foreign_from_opencv, T[:3, 3]).inverse()
+
+
+def mitsuba_to_world(cam_from_world: Rigid3) -> np.ndarray:
+    """Mitsuba sensor ``to_world`` (4x4, Mitsuba camera -> world) for an OpenCV ``cam_from_world``."""
+    return _camera_to_world(cam_from_world, MITSUBA_FROM_OPENCV_CAM)
+
+
 def cam_from_world_from_mitsuba(to_world) -> Rigid3:
     """Inverse of :func:`mitsuba_to_world`."""
-    T = np.asarray(to_world, dtype=np.float64)
-    return Rigid3(T[:3, :3] @ MITSUBA_FROM_OPENCV_CAM, T[:3, 3]).inverse()
+    return _cam_from_world(to_world, MITSUBA_FROM_OPENCV_CAM)
 
 
 def opengl_cam_to_world(cam_from_world: Rigid3) -> np.ndarray:
     """OpenGL/NeRF camera-to-world 4x4 (``transform_matrix`` of transforms.json); also Blender's
     camera ``matrix_world``."""
-    world_from_cam = cam_from_world.inverse()
-    T = np.eye(4)
-    T[:3, :3] = world_from_cam.R @ OPENGL_FROM_OPENCV_CAM.T
-    T[:3, 3] = world_from_cam.t
-    return T
+    return _camera_to_world(cam_from_world, OPENGL_FROM_OPENCV_CAM)
 
 
 def cam_from_world_from_opengl(cam_to_world) -> Rigid3:
     """Inverse of :func:`opengl_cam_to_world`."""
-    T = np.asarray(cam_to_world, dtype=np.float64)
-    return Rigid3(T[:3, :3] @ OPENGL_FROM_OPENCV_CAM, T[:3, 3]).inverse()
+    return _cam_from_world(cam_to_world, OPENGL_FROM_OPENCV_CAM)
 
 
 # Blender cameras use the OpenGL camera axes in a Z-up world identical to ours.
