@@ -1,5 +1,4 @@
 """The renderer and the truth pass against the camera model and analytic geometry."""
-import math
 
 import numpy as np
 import pytest

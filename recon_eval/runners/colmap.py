@@ -66,6 +66,10 @@ def incremental(ds, out_dir, options) -> RunOutput:
     names = tuple(n.rsplit(".", 1)[0] for n in est.names)
     est = Poses(names, est.R_cam_from_world, est.t_cam_from_world)
     gt = ds.poses
+    if best.num_reg_images() < 3:  # Sim(3) needs 3 centres: a failed run, scored as such, not an input error
+        out.metrics.update({"registration_ratio": registration_ratio(est, gt), "max_rot_err_deg": float("inf")})
+        out.notes["failed"] = f"largest model registers {best.num_reg_images()} images (< 3 for Sim(3))"
+        return out
     a = ape(est, gt, alignment=Alignment.SIM3)
     out.results["ape_sim3"] = a
     rr = registration_ratio(est, gt)

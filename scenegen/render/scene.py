@@ -8,10 +8,8 @@ UVs pass through unchanged (checked in tests/test_render.py).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
-import drjit as dr
 import mitsuba as mi
 import numpy as np
 import trimesh
