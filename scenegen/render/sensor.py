@@ -103,7 +103,7 @@ class ScenegenSensor(mi.Sensor):
         if tm is not None:
             # seconds from mid-exposure: position in the (sub-frame) window, plus the row's offset
             tau = (tm.t0 + time * (tm.t1 - tm.t0) - 0.5) * tm.exposure
-            tau = tau + tm.readout * (v / max(self.height - 1, 1) - 0.5)
+            tau = tau + tm.readout * (v / max(self.height - 1, 1) - 0.5)  # = optics.Shutter.row_time_s(v)
             if tm.rotating:  # Rodrigues: world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau]
                 k = mi.Vector3f(*tm.axis)
                 ang = tm.speed * tau
