@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from recon_eval._arrays import as_float_array
+from recon_eval.align import _normalising_transform as _normalise_3d  # Hartley normalisation in P^3
 from recon_eval.align import cameras_to_truth_frame, projective_align
 from recon_eval.errors import InputError
 from recon_eval.rotation import rotation_error_rad
@@ -187,16 +188,6 @@ def _normalise_2d(x: np.ndarray) -> np.ndarray:
     d = np.mean(np.linalg.norm(x - mu, axis=1))
     s = np.sqrt(2.0) / d if d > 0 else 1.0
     return np.array([[s, 0.0, -s * mu[0]], [0.0, s, -s * mu[1]], [0.0, 0.0, 1.0]])
-
-
-def _normalise_3d(X: np.ndarray) -> np.ndarray:
-    mu = X.mean(axis=0)
-    d = np.mean(np.linalg.norm(X - mu, axis=1))
-    s = np.sqrt(3.0) / d if d > 0 else 1.0
-    U = np.eye(4)
-    U[:3, :3] *= s
-    U[:3, 3] = -s * mu
-    return U
 
 
 def dlt_projection(points_world, pixels) -> np.ndarray:
