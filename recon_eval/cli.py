@@ -123,8 +123,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--points-world", help="non-dataset truth: (N, 3) .npy world points for reprojection")
     p.add_argument("--pixels", help="non-dataset truth: (N, 2) .npy pixels observing them")
     p.add_argument("--calib", help="non-dataset truth: camera for reprojection (OpenCV YAML/JSON)")
+    from recon_eval import cli_features, cli_geometry
     from recon_eval.cli_tools import add_parsers  # run, leaderboard, gate (docs/ci.md)
 
+    cli_features.add_parsers(add)  # features (docs/features.md)
+    cli_geometry.add_parsers(add)  # dlt, triangulation
     add_parsers(sub)
     return ap
 
@@ -691,6 +694,12 @@ _COMMANDS = {"cloud": _cmd_cloud, "poses": _cmd_poses, "disparity": _cmd_dispari
              "pnp": _cmd_pnp}
 
 
+def _commands() -> dict:
+    from recon_eval import cli_features, cli_geometry
+
+    return {**_COMMANDS, **cli_features.COMMANDS, **cli_geometry.COMMANDS}
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)  # argparse itself exits with code 2 on bad usage
     from recon_eval import cli_tools
@@ -701,7 +710,7 @@ def main(argv=None) -> int:
     from recon_eval.report import document, print_table, write_json_atomic
 
     try:
-        inputs, results, figures = _COMMANDS[args.command](args)
+        inputs, results, figures = _commands()[args.command](args)
         if not args.quiet:
             print_table(f"recon-eval {args.command}", results)
         if args.json:

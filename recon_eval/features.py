@@ -20,8 +20,19 @@ pixel centre needs only that centre; one near an occlusion boundary or outside
   (:func:`mean_over_pairs`). A match whose x_i has no truth in j (occluded, out of frame, no
   surface) is counted as wrong (distance inf) and reported in ``n_no_truth``: with exact
   occlusion there is no correct match for it. A pair with no match has MMA 0.
-* Matching score (Mikolajczyk & Schmid, TPAMI 2005): correct matches (distance ``<= eps_px``)
-  divided by the smaller of the two keypoint counts with truth in the other view.
+* Matching score (Mikolajczyk & Schmid, TPAMI 2005): correct matches divided by the smaller of
+  the two keypoint counts with truth in the other view. A match is correct when its distance is
+  ``<= eps_px`` and both its keypoints have truth (both lie in the region visible in both views,
+  as the denominator's keypoints do; otherwise a perfect result scores above 1 where the j
+  keypoint's interpolation support touches a pixel not visible in i).
+* Precision and recall of putative matches against the truth (the family of Mikolajczyk & Schmid,
+  TPAMI 2005, sec. 4.1: recall = correct matches / correspondences, 1 - precision = false / all
+  matches), per keypoint of view i: a putative match is correct iff its truth distance is
+  ``<= eps_px``; precision = correct / putative (0 without putative matches; at ``eps_px`` = t it
+  equals MMA@t); a keypoint of i is *matchable* iff it has truth in j and some keypoint of j lies
+  within ``eps_px`` (``<=``) of that truth position; recall = keypoints of i with at least one
+  correct match / matchable keypoints of i (NaN when none is matchable). A keypoint with a correct
+  match is matchable, so recall lies in [0, 1] whatever the matcher returns (duplicates included).
 """
 from __future__ import annotations
 
@@ -41,10 +52,12 @@ MMA_THRESHOLDS_PX = tuple(float(t) for t in range(1, 11))
 
 @dataclass(frozen=True)
 class CorrespondenceMap:
-    """Truth map of view i into view j: ``uv`` (H, W, 2) float64 pixels of j, ``state`` (H, W)."""
+    """Truth map of view i into view j: ``uv`` (H, W, 2) float64 pixels of j, ``state`` (H, W),
+    and optionally ``z`` (H, W) float64 metres, the depth in j of each pixel's point (NaN: none)."""
 
     uv: np.ndarray
     state: np.ndarray
+    z: np.ndarray | None = None
 
     def __post_init__(self):
         uv = as_float_array(self.uv, "correspondence uv", (None, None, 2))
@@ -53,6 +66,8 @@ class CorrespondenceMap:
             raise InputError(f"correspondence state: expected shape {uv.shape[:2]}, got {st.shape}")
         object.__setattr__(self, "uv", uv)
         object.__setattr__(self, "state", st.astype(np.uint8))
+        if self.z is not None:
+            object.__setattr__(self, "z", as_float_array(self.z, "correspondence z", st.shape))
 
 
 def read_correspondence_map(path) -> CorrespondenceMap:
@@ -66,7 +81,8 @@ def read_correspondence_map(path) -> CorrespondenceMap:
     missing = [c for c in ("u", "v", "state") if c not in ch]
     if missing:
         raise InputError(f"{path}: no channel(s) {missing} (a correspondence file has u, v, z, state)")
-    return CorrespondenceMap(np.stack([ch["u"], ch["v"]], axis=-1).astype(np.float64), ch["state"])
+    z = ch["z"].astype(np.float64) if "z" in ch else None
+    return CorrespondenceMap(np.stack([ch["u"], ch["v"]], axis=-1).astype(np.float64), ch["state"], z)
 
 
 def map_keypoints(keypoints, cmap: CorrespondenceMap):
@@ -176,19 +192,58 @@ class MatchingScore:
 def matching_score(kp_i, kp_j, matches, map_ij: CorrespondenceMap, map_ji: CorrespondenceMap,
                    eps_px: float = 3.0) -> MatchingScore:
     """Matching score of ``matches`` (M, 2) int indices (into kp_i, kp_j): correct matches (truth
-    distance ``<= eps_px``) over the smaller count of keypoints with truth in the other view."""
+    distance ``<= eps_px``, both keypoints with truth) over the smaller count of keypoints with
+    truth in the other view."""
     kp_i = as_float_array(kp_i, "kp_i", (None, 2))
     kp_j = as_float_array(kp_j, "kp_j", (None, 2))
+    mt = _match_indices(matches, len(kp_i), len(kp_j))
+    acc = match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij, (eps_px,))
+    ok_i = map_keypoints(kp_i, map_ij)[1]
+    ok_j = map_keypoints(kp_j, map_ji)[1]
+    n_correct = int(np.sum((acc.dist_px <= eps_px) & ok_j[mt[:, 1]]))  # ok_i is implied by a finite distance
+    n_i, n_j = int(ok_i.sum()), int(ok_j.sum())
+    den = min(n_i, n_j)
+    return MatchingScore(float(eps_px), n_correct / den if den else float("nan"), n_correct, n_i, n_j)
+
+
+def _match_indices(matches, n_i: int, n_j: int) -> np.ndarray:
+    """(M, 2) int64 indices, checked against the keypoint counts."""
     mt = np.asarray(matches)
     if mt.size == 0:
         mt = np.zeros((0, 2), dtype=np.int64)
     if mt.ndim != 2 or mt.shape[1] != 2 or not np.issubdtype(mt.dtype, np.integer):
         raise InputError(f"matches: expected (M, 2) integer indices, got {mt.shape} {mt.dtype}")
-    if len(mt) and (mt.min() < 0 or mt[:, 0].max() >= len(kp_i) or mt[:, 1].max() >= len(kp_j)):
+    if len(mt) and (mt.min() < 0 or mt[:, 0].max() >= n_i or mt[:, 1].max() >= n_j):
         raise InputError("matches: index out of range of the keypoints")
+    return mt.astype(np.int64)
+
+
+@dataclass(frozen=True)
+class MatchPrecisionRecall:
+    eps_px: float
+    precision: float  # n_correct / n_putative; 0 without putative matches
+    recall: float  # n_i_recalled / n_i_matchable; NaN when no keypoint of i is matchable
+    n_putative: int
+    n_correct: int  # putative matches with truth distance <= eps_px
+    n_i_recalled: int  # distinct keypoints of i with at least one correct match
+    n_i_matchable: int  # keypoints of i with truth in j and a keypoint of j within eps_px of it
+
+
+def match_precision_recall(kp_i, kp_j, matches, map_ij: CorrespondenceMap,
+                           eps_px: float = 3.0) -> MatchPrecisionRecall:
+    """Precision and recall of putative ``matches`` (M, 2) int indices into ``kp_i`` (N, 2) and
+    ``kp_j`` (K, 2), OpenCV pixels, against the truth map i -> j (module docstring)."""
+    kp_i = as_float_array(kp_i, "kp_i", (None, 2))
+    kp_j = as_float_array(kp_j, "kp_j", (None, 2))
+    mt = _match_indices(matches, len(kp_i), len(kp_j))
     acc = match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij, (eps_px,))
-    n_correct = int(np.sum(acc.dist_px <= eps_px))
-    n_i = int(map_keypoints(kp_i, map_ij)[1].sum())
-    n_j = int(map_keypoints(kp_j, map_ji)[1].sum())
-    den = min(n_i, n_j)
-    return MatchingScore(float(eps_px), n_correct / den if den else float("nan"), n_correct, n_i, n_j)
+    correct = acc.dist_px <= eps_px
+    m, ok = map_keypoints(kp_i, map_ij)
+    d = np.full(len(kp_i), np.inf)
+    d[ok] = _nearest(m[ok], kp_j[np.all(np.isfinite(kp_j), axis=1)])
+    n_matchable = int(np.sum(d <= eps_px))
+    n_recalled = len(np.unique(mt[correct, 0]))
+    n_put, n_cor = len(mt), int(correct.sum())
+    return MatchPrecisionRecall(float(eps_px), n_cor / n_put if n_put else 0.0,
+                                n_recalled / n_matchable if n_matchable else float("nan"),
+                                n_put, n_cor, n_recalled, n_matchable)

@@ -8,10 +8,7 @@ from __future__ import annotations
 
 import base64
 import html
-import os
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 from recon_eval import SCHEMA_VERSION, __version__
 from recon_eval.report import scalar_rows, to_jsonable
@@ -60,13 +57,7 @@ def render_html(command: str, inputs: dict, results: dict, figures: list[Figure]
 
 
 def write_html_atomic(path, text: str) -> None:
-    p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, p)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Write the report atomically (:func:`scenegen.io.atomic_write`)."""
+    from scenegen.io import atomic_write_bytes
+
+    atomic_write_bytes(path, text.encode("utf-8"))

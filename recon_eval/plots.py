@@ -229,3 +229,99 @@ def field_figure(field, grid_u, grid_v, *, title: str, unit: str) -> bytes:
     fig.colorbar(pc, ax=ax, label=unit)
     ax.set_title(title, fontsize=11)
     return _png(fig)
+
+
+def triangulation_angle_figure(curves: dict, *, title: str, points=None, guide=None, max_points: int = 4000,
+                               seed: int = 0) -> bytes:
+    """Triangulation error against the triangulation (baseline) angle, log-log: left the median
+    error (m), right the median error over the truth depth, one marker per non-empty angle bin.
+
+    ``curves``: label -> (angle_deg (K,), lo_deg (K,), hi_deg (K,), median_m (K,), median_rel (K,))
+    of the bins: a marker at the median angle of the bin's points with a bar spanning [lo, hi).
+    NaN / zero medians (empty bins, exact results) are left out of a log plot.
+    ``points``: optional (angle_deg (N,), err_m (N,), rel_err (N,)) drawn faintly behind (at most
+    ``max_points``, seeded sample; failures (inf) and exact zeros are left out of a log plot).
+    ``guide``: optional (sigma_px, f_px): the first-order law ``sigma / (f theta)`` on the right
+    (the depth error of a point seen from two views under angle theta, relative to its depth)."""
+    plt = _plt()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    if points is not None:
+        a, e, r = (np.asarray(v, float).ravel() for v in points)
+        keep = np.flatnonzero(np.isfinite(e) & (e > 0) & (a > 0))
+        if len(keep) > max_points:
+            keep = np.sort(np.random.default_rng(seed).choice(keep, max_points, replace=False))
+        for ax, y in ((axes[0], e), (axes[1], r)):
+            ax.plot(a[keep], y[keep], ".", ms=1.5, color="0.75", zorder=1, label="points")
+    for label, (x, lo, hi, med, rel) in curves.items():
+        x, lo, hi, med, rel = (np.asarray(v, float) for v in (x, lo, hi, med, rel))
+        for ax, y in ((axes[0], med), (axes[1], rel)):
+            ok = np.isfinite(y) & (y > 0)
+            left = np.maximum(lo[ok], x[ok] / 2)  # a log axis has no 0: a [0, hi) bin's bar starts at x / 2
+            ax.errorbar(x[ok], y[ok], xerr=[x[ok] - left, hi[ok] - x[ok]], fmt="o-", ms=4, capsize=2, zorder=3,
+                        label=label)
+    if guide is not None:
+        sigma_px, f_px = guide
+        th = np.geomspace(0.2, 90.0, 50)
+        axes[1].plot(th, sigma_px / (f_px * np.radians(th)), "k--", lw=0.8, zorder=2,
+                     label=f"sigma / (f theta), sigma {sigma_px:g} px, f {f_px:g} px")
+    for ax, yl in ((axes[0], "median error (m)"), (axes[1], "median error / truth depth")):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("triangulation angle at the truth point (deg)")
+        ax.set_ylabel(yl)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=11)
+    return _png(fig)
+
+
+def mma_curves_figure(curves: dict, *, title: str) -> bytes:
+    """Mean matching accuracy against the pixel threshold (D2-Net, HPatches): for each label ->
+    (thresholds_px (T,), mma (T,)) one curve; MMA is the fraction of putative matches within the
+    threshold (<=), averaged over the image pairs."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    top = 1.0
+    for label, (t, m) in curves.items():
+        t = np.asarray(t, float)
+        ax.plot(t, np.asarray(m, float), "o-", ms=3, label=label)
+        top = max(top, float(t.max()))
+    ax.set_xlim(0.5, top + 0.5)
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel("threshold (px)")
+    ax.set_ylabel("MMA (fraction of matches <= threshold)")
+    ax.set_title(title, fontsize=11)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    return _png(fig)
+
+
+def metric_vs_figure(x, curves: dict, *, xlabel: str, ylabel: str, title: str, xticklabels=None,
+                     logx: bool = False) -> bytes:
+    """Per-pair metrics against what varies along a series: ``x`` (P,) (angle, scale ratio, or the
+    pair index with ``xticklabels``), ``curves`` label -> (P,) values in [0, 1]; NaN (undefined)
+    values are left out of the line and marked with a red x at 0."""
+    plt = _plt()
+    x = np.asarray(x, float)
+    order = np.argsort(x, kind="stable")
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for label, y in curves.items():
+        y = np.asarray(y, float)[order]
+        ok = np.isfinite(y)
+        ax.plot(x[order][ok], y[ok], "o-", ms=4, label=label)
+        if (~ok).any():
+            ax.plot(x[order][~ok], np.zeros((~ok).sum()), "x", color="red", ms=8, mew=2)
+    if logx:  # scale ratios: log axis, ticks at the pairs' own ratios
+        ax.set_xscale("log", base=2)
+        ax.minorticks_off()
+        ax.set_xticks(x, [f"{v:.3g}" for v in x])
+    if xticklabels is not None:
+        ax.set_xticks(x)
+        ax.set_xticklabels([str(s) for s in xticklabels], rotation=45 if len(x) > 4 else 0, fontsize=8, ha="right")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=11)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _png(fig)

@@ -10,10 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
-import tempfile
 from enum import Enum
-from pathlib import Path
 
 import numpy as np
 
@@ -55,19 +52,11 @@ def document(command: str, inputs: dict, results: dict) -> dict:
 
 
 def write_json_atomic(path, doc: dict) -> None:
-    """Write ``doc`` to ``path`` via a temporary file in the same directory and os.replace, so a
-    reader never sees a half-written file."""
-    p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
-    try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(doc, f, indent=2, allow_nan=False)
-            f.write("\n")
-        os.replace(tmp, p)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Write ``doc`` to ``path`` atomically (:func:`scenegen.io.atomic_write`: a temporary file in
+    the same directory, fsync, os.replace), so a reader never sees a half-written file."""
+    from scenegen.io import atomic_write_bytes
+
+    atomic_write_bytes(path, (json.dumps(doc, indent=2, allow_nan=False) + "\n").encode("utf-8"))
 
 
 def scalar_rows(results: dict) -> list[tuple[str, str, str]]:

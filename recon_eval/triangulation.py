@@ -82,6 +82,7 @@ class AngleBin:
     mean_m: float
     rms_m: float
     median_rel: float  # median of error / truth depth
+    median_angle_deg: float  # median triangulation angle of the bin's points
 
 
 @dataclass(frozen=True)
@@ -132,8 +133,23 @@ def score_triangulation(points_est, points_true, cam1_from_world, cam2_from_worl
     ok = np.all(np.isfinite(Xe), axis=1)
     err = np.full(len(Xt), np.inf)
     err[ok] = np.linalg.norm(Xe[ok] - Xt[ok], axis=1)
-    rel = err / z
     ang = triangulation_angle_deg(Xt, -R1.T @ t1, -R2.T @ t2) if len(Xt) else np.zeros(0)
+    return _summarise(err, err / z, ang, angle_bins_deg)
+
+
+def pool_scores(scores, angle_bins_deg=ANGLE_BINS_DEG) -> TriangulationScore:
+    """One :class:`TriangulationScore` over the points of several scores (e.g. the camera pairs of
+    a task): their per-point errors, relative errors and angles pooled, then summarised and binned
+    exactly as :func:`score_triangulation` does."""
+    scores = list(scores)
+    cat = [np.concatenate([getattr(s, f) for s in scores]) if scores else np.zeros(0)
+           for f in ("err_m", "rel_err", "angle_deg")]
+    return _summarise(*cat, angle_bins_deg)
+
+
+def _summarise(err, rel, ang, angle_bins_deg) -> TriangulationScore:
+    """Totals and angle bins of per-point errors (N,) (inf = failure), relative errors and angles."""
+    ok = np.isfinite(err)
     edges = np.asarray(angle_bins_deg, dtype=np.float64)
     if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0):
         raise InputError(f"angle_bins_deg: expected increasing edges, got {angle_bins_deg}")
@@ -142,9 +158,9 @@ def score_triangulation(points_est, points_true, cam1_from_world, cam2_from_worl
         sel = (ang >= lo) & ((ang < hi) | ((k == len(edges) - 2) & (ang <= hi)))
         med, mean, rms = _stats(err[sel])
         bins.append(AngleBin(float(lo), float(hi), int(sel.sum()), int(np.sum(sel & ~ok)), med, mean, rms,
-                             _stats(rel[sel])[0]))
+                             _stats(rel[sel])[0], _stats(ang[sel])[0]))
     med, mean, rms = _stats(err)
     return TriangulationScore(
-        len(Xt), int(np.sum(~ok)), mean, med, rms, float(err.max()) if len(err) else float("nan"),
+        len(err), int(np.sum(~ok)), mean, med, rms, float(err.max()) if len(err) else float("nan"),
         _stats(rel)[0], _stats(rel)[1], tuple(bins), frozen(err), frozen(rel), frozen(ang),
     )

@@ -62,7 +62,9 @@ def cmd_render(args) -> int:
 def _print_summary(s) -> None:
     per = s.seconds / max(s.views_rendered, 1)
     print(f"wrote {s.out_dir}: {s.views_rendered} views rendered, {s.views_skipped} already complete, "
-          f"{s.seconds:.1f} s ({per:.2f} s/view), variant {s.settings.variant}, spp {s.settings.spp}")
+          f"{s.seconds:.1f} s ({per:.2f} s/view), variant {s.settings.variant}, "
+          f"spp {s.settings.spp}" + (f" (sampler takes {s.settings.spp_effective})"
+                                     if s.settings.spp_effective != s.settings.spp else ""))
     print(f"  images: {s.out_dir / 'images'}   truth: {s.out_dir / 'truth'}   cameras: {s.out_dir / 'cameras.json'}")
 
 

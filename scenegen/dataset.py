@@ -154,6 +154,9 @@ class ViewCamera:
     rig_member: str | None = None  # member name inside the rig
     frame_index: int = 0  # index of the frame (rig pose) this view belongs to
     optics: Mapping[str, Any] | None = None  # lens, shutter, chromatic aberration, camera motion
+    view_set: str | None = None  # prefix name of the spec view set the view belongs to
+    lights: Mapping[str, float] | None = None  # every spec light -> factor on its spec power
+    # used for this view (0 = off); None (older datasets) = not recorded
 
     def to_dict(self) -> dict:
         cam = self.camera.to_dict() if hasattr(self.camera, "to_dict") else dict(self.camera)
@@ -161,6 +164,10 @@ class ViewCamera:
         pose = pose.to_dict() if isinstance(pose, Rigid3) else Rigid3.from_dict(pose).to_dict()
         d = {"camera": cam, "cam_from_world": pose, "camera_name": self.camera_name,
              "rig": self.rig, "rig_member": self.rig_member, "frame_index": int(self.frame_index)}
+        if self.view_set is not None:
+            d["view_set"] = str(self.view_set)
+        if self.lights is not None:
+            d["lights"] = {str(k): float(v) for k, v in self.lights.items()}
         if self.optics:
             d["optics"] = dict(self.optics)
         return d

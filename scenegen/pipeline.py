@@ -13,12 +13,14 @@ import numpy as np
 from scenegen import dataset as ds
 from scenegen import io as sio
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
+from scenegen.spec.views import light_scales_dict
 from scenegen.textures import linear_to_srgb
 
 
 @dataclass(frozen=True)
 class RenderSettingsUsed:
-    spp: int
+    spp: int  # asked for (spec or --spp)
+    spp_effective: int  # what the sampler takes per pixel (Mitsuba rounds some counts up)
     seed: int
     variant: str  # the resolved Mitsuba variant
     sampler: str
@@ -103,8 +105,11 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     mi = load_mitsuba(variant or rs.variant)
     from scenegen.render.scene import build_scene
 
-    used = RenderSettingsUsed(spp=spp, seed=seed, variant=mi.variant(), sampler=rs.sampler,
-                              max_depth=rs.max_depth, bit_depth=rs.bit_depth)
+    from scenegen.spec.model import effective_spp
+
+    used = RenderSettingsUsed(spp=spp, spp_effective=effective_spp(rs.sampler, spp), seed=seed,
+                              variant=mi.variant(), sampler=rs.sampler, max_depth=rs.max_depth,
+                              bit_depth=rs.bit_depth)
     # The run's identity: the spec plus every override that changes output bytes.
     run_hash = hashlib.sha256((spec_sha256(spec) + json.dumps(used.__dict__, sort_keys=True)).encode()).hexdigest()
 
@@ -114,7 +119,9 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                               versions=ds.software_versions(), resume=resume)
     view_cams = {v.name: ds.ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
-                                       frame_index=v.frame_index, optics=view_optics(built, v))
+                                       frame_index=v.frame_index, optics=view_optics(built, v),
+                                       view_set=spec.view_sets[v.view_set].prefix,
+                                       lights=light_scales_dict(spec, v.light_scales))
                  for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
@@ -166,7 +173,7 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     from scenegen.render.truth import truth_pass
 
     linear = render_view(built, v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index),
-                         motion=v.motion)
+                         motion=v.motion, light_scales=v.light_scales)
     truth = truth_pass(built.scene, built.cameras[v.camera], v.cam_from_world, built.id_tables,
                        row_poses=rolling_shutter_rows(built, v))
     params = spec.cameras[v.camera].imaging

@@ -173,6 +173,31 @@ def test_twoview_known_values():
     assert np.allclose(x[:2] / x[2], [40.0, 40.0])
 
 
+def test_twoview_zero_baseline():
+    """A roll about the optical axis (one centre) and the very same pose: no E, F or epipoles
+    (null in JSON, not NaN or noise); the plane homography is the infinite one, K R K^-1."""
+    import json
+
+    from scenegen.pose import look_at
+
+    cam = Camera("pinhole", 100, 80, 100, 100, 49.5, 39.5)
+    eye = [0.3, -1.2, 1.0]
+    ref = look_at(eye, [0.3, 0, 1.0]).inverse()
+    rolled = look_at(eye, [0.3, 0, 1.0], up=[np.sin(0.5), 0, np.cos(0.5)]).inverse()
+    for other in (rolled, ref):
+        tv = TwoView.of(cam, ref, cam, other)
+        assert tv.E is None and tv.F is None and tv.epipole_i is None and tv.epipole_j is None
+        d = json.loads(sio.encode_json(tv.to_dict()))  # JSON has no NaN: this would raise
+        assert d["E"] is d["F"] is d["epipole_i_px"] is None and d["baseline_m"] < 1e-12
+        H = plane_homography(cam.K, cam.K, tv.j_from_i, [0, 0, 1.0], 1.2)
+        H_inf = cam.K @ tv.j_from_i.R @ np.linalg.inv(cam.K)
+        assert np.allclose(H, H_inf / H_inf[2, 2], atol=1e-9)
+    # the roll turns the image about the principal point, counter-clockwise on screen: a point
+    # 10 px right of it moves up by 0.5 rad
+    x = plane_homography(cam.K, cam.K, TwoView.of(cam, ref, cam, rolled).j_from_i, [0, 0, 1.0], 1.2) @ [59.5, 39.5, 1]
+    assert np.allclose(x[:2] / x[2], [49.5 + 10 * np.cos(0.5), 39.5 - 10 * np.sin(0.5)], atol=1e-9)
+
+
 # --- occlusion against an analytic occluder ------------------------------------------------
 OCC_SPEC = """
 objects:

@@ -266,3 +266,29 @@ views:
     np.testing.assert_allclose(down.mean(axis=(0, 1)), (0.8, 0.3, 0.1), atol=0.02)
     # looking 17 degrees above the horizon: sky in the whole view (fov 30 deg horizontally)
     assert horizon[:3].mean(axis=(0, 1))[2] > 0.8
+
+
+@pytest.mark.parametrize("sampler", ["ldsampler", "orthogonal", "stratified", "multijitter", "independent"])
+def test_effective_spp_is_what_mitsuba_takes(mi, sampler):
+    """The spec layer's rounding rule (no Mitsuba import there) against the plugin itself."""
+    from scenegen.spec.model import effective_spp
+
+    counts = list(range(1, 130)) + [255, 256, 257, 1000, 1024]
+    got = [mi.load_dict({"type": sampler, "sample_count": n}).sample_count() for n in counts]
+    assert [effective_spp(sampler, n) for n in counts] == got
+
+
+def test_spp_warning_and_record(tmp_path):
+    from scenegen.pipeline import render_spec
+
+    spec = ("render: {spp: 8}\nobjects: [{name: p, shape: plane}]\ncameras: {c: {size: [8, 6], fx: 8}}\n"
+            "views: [{camera: c, look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]}]\n")
+    s = parse_spec(spec, "s.yaml")
+    assert any("ldsampler rounds it up to 16" in w for w in s.warnings)
+    (tmp_path / "s.yaml").write_text(spec)
+    out = render_spec(tmp_path / "s.yaml", tmp_path / "out", progress=False)
+    assert (out.settings.spp, out.settings.spp_effective) == (8, 16)
+    import json
+
+    used = json.loads((tmp_path / "out" / "cameras.json").read_text())["spec"]["render_used"]
+    assert (used["spp"], used["spp_effective"]) == (8, 16)

@@ -10,6 +10,10 @@ from scenegen.errors import SpecError
 from scenegen.spec import load_spec, parse_spec
 
 CAM = "cameras:\n  cam: {size: [640, 480], fov_deg: 60}\n"
+# two named lights and a view set whose `lights:` the rows below append (line 9 on)
+LIT = (CAM + "lights:\n  - {type: area, name: key_light, position: [0, -1, 2], look_at: [0, 0, 0], "
+       "radiance: 5}\n  - {type: point, name: fill, position: [1, 1, 1], intensity: 2}\n"
+       "views:\n  - camera: cam\n    look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]\n")
 
 # (id, spec text, line, field path (None: none), message fragment)
 CASES = [
@@ -264,6 +268,40 @@ CASES = [
     ("crossview_sift_inlier_px_zero",
      CAM + "crossview: {sift: true, sift_inlier_px: 0}\n",
      3, "crossview.sift_inlier_px", "expected a value > 0 (pixels)"),
+    # per-view-set lighting (views[i].lights)
+    ("view_lights_unknown_name_suggests",
+     LIT + "    lights: [key_lite]\n",
+     9, "views[0].lights[0]",
+     "undefined light 'key_lite' (did you mean 'key_light'?); defined under lights: key_light, fill"),
+    ("view_lights_unknown_name_in_mapping",
+     LIT + "    lights:\n      key_light: 1\n      fil: 0.5\n",
+     11, "views[0].lights.fil", "undefined light 'fil' (did you mean 'fill'?)"),
+    ("view_lights_negative_scale",
+     LIT + "    lights: {key_light: -0.5}\n",
+     9, "views[0].lights.key_light", "expected a value >= 0 (factor on the light's spec power), got -0.5"),
+    ("view_lights_infinite_scale",
+     LIT + "    lights: {fill: .inf}\n",
+     9, "views[0].lights.fill", "expected a finite number"),
+    ("view_lights_scale_not_a_number",
+     LIT + "    lights: {fill: bright}\n",
+     9, "views[0].lights.fill", "expected a number (factor on the light's spec power), got 'bright'"),
+    ("view_lights_wrong_type",
+     LIT + "    lights: key_light\n",
+     9, "views[0].lights", "expected a list of light names (on at their spec power, the others off) "
+                           "or a mapping of light names to factors >= 0, got 'key_light'"),
+    ("view_lights_name_not_a_string",
+     LIT + "    lights: [3]\n",
+     9, "views[0].lights[0]", "expected a light name, got 3"),
+    ("view_lights_duplicate_name",
+     LIT + "    lights:\n      - fill\n      - key_light\n      - fill\n",
+     12, "views[0].lights[2]", "duplicate light 'fill' (first at line 10)"),
+    ("view_lights_empty",
+     LIT + "    lights: []\n",
+     9, "views[0].lights", "expected at least one light"),
+    ("view_lights_without_spec_lights",
+     CAM + "views:\n  - camera: cam\n    look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]\n"
+     "    lights: [light0]\n",
+     6, "views[0].lights", "the spec defines no lights"),
 ]
 
 

@@ -3,7 +3,9 @@
 One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fisheye),
 :mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
-SfM), :mod:`.broken` (deliberately wrong estimators that gates must catch).
+SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
+:mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
+:mod:`.broken` (deliberately wrong estimators that gates must catch).
 
 :func:`run_method` runs one registered method and writes ``OUT/result.json`` (the run-result
 JSON, ``command: "run"``, docs/ci.md) next to the raw outputs.
@@ -53,6 +55,13 @@ METHODS: dict[str, Method] = {m.name: m for m in [
       for s in ("iterative", "epnp", "sqpnp", "ap3p")],
     _m("pycolmap-incremental", "colmap", "incremental",
        "pycolmap extract_features + match_exhaustive + incremental_mapping"),
+    *[_m(f"opencv-features-{d}", "features", "run",
+         f"cv2.{d.upper()}_create() (default parameters), BFMatcher mutual nearest neighbours", detector=d)
+      for d in ("sift", "orb", "akaze", "brisk")],
+    _m("dlt-linear", "dlt", "linear",
+       "normalised linear DLT (H&Z Alg. 7.1, linear steps) on detected board corners and on noisy truth points"),
+    _m("opencv-triangulate", "triangulate", "opencv",
+       "cv2.triangulatePoints on noisy exact truth correspondences of the cross-view pairs (sigma 0 and 1 px)"),
     _m("broken-calib-cx", "calibration", "broken_cx", "DELIBERATELY BROKEN: checkerboard calibration, cx + 2 px"),
     _m("broken-f-transposed", "twoview", "fundamental", "DELIBERATELY BROKEN: RANSAC F, transposed",
        flag="ransac", transpose=True),

@@ -35,6 +35,8 @@ MAX_ITERS = 10000
 TRUTH_POINTS = 20000
 #: Seed of the 7-point method's sample.
 SEVEN_POINT_SEED = 7
+#: Note of a pair skipped by the F and E runners: its two views share one camera centre.
+ZERO_BASELINE_NOTE = "skipped: zero baseline (one camera centre), no epipolar geometry to estimate"
 #: Minimum number of matches on a plane for a homography to be attempted.
 MIN_PLANE_MATCHES = 12
 
@@ -99,6 +101,9 @@ def fundamental(ds, out_dir, options) -> RunOutput:
         i, j = pair["i"], pair["j"]
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
         tv = _truth(ds, i, j)
+        if tv["F"] is None:  # one camera centre (crossview.md): F and E do not exist
+            out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
+            continue
         F_gt = np.asarray(tv["F"], np.float64)
         rel = pj @ pi.inverse()
         t1, t2 = ds.correspondences(i, j, max_points=TRUTH_POINTS)
@@ -149,7 +154,7 @@ def fundamental(ds, out_dir, options) -> RunOutput:
                                            "true_inliers": int((labels == 0).sum()),
                                            "threshold_px": None if flag in ("7point", "8point") else _thresh(flag)}
     if not out.raw_files:
-        raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets")
+        raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets (or only zero-baseline pairs)")
     return out
 
 
@@ -166,6 +171,9 @@ def essential(ds, out_dir, options) -> RunOutput:
         i, j = pair["i"], pair["j"]
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
         rel = pj @ pi.inverse()
+        if _truth(ds, i, j)["E"] is None:
+            out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
+            continue
         for kind, rows in _match_sets(ds, i, j):
             # normalised coordinates through each truth camera (the two intrinsics may differ)
             n1 = ci.unproject(rows[:, 0:2])[:, :2]
@@ -194,7 +202,7 @@ def essential(ds, out_dir, options) -> RunOutput:
             out.metrics.update({pre + "pose_err_deg": ep, pre + "rot_err_deg": eR, pre + "inlier_recall": ir.recall,
                                 pre + "inlier_precision": ir.precision})
     if not out.raw_files:
-        raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets")
+        raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets (or only zero-baseline pairs)")
     return out
 
 

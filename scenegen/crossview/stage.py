@@ -8,7 +8,8 @@ Views are projected into each other with their mid-exposure poses (the scene is 
 mid-exposure, as for the truth): for a moving camera with a rolling shutter, i's points follow
 its per-row poses but j is projected as a global shutter at its mid-exposure pose. Rectified
 stereo views are ideal pinholes: no lens blur, motion or chromatic aberration, and the
-pipeline's clean sRGB encoding. File layout: docs/crossview.md.
+pipeline's clean sRGB encoding, both under the left view's lighting (its view set's
+``lights``). File layout: docs/crossview.md.
 """
 from __future__ import annotations
 
@@ -177,9 +178,12 @@ def _stereo_frames(views, rigs) -> list[tuple[str, str]]:
     return [(f["left"], f["right"]) for f in frames.values() if "left" in f and "right" in f]
 
 
-def _render_rectified(ctx, sensor_camera_name, camera, pose, *, spp, seed):
+def _render_rectified(ctx, sensor_camera_name, camera, pose, *, spp, seed, light_scales=None):
     import mitsuba as mi
 
+    from scenegen.render.scene import set_lighting
+
+    set_lighting(ctx.built, light_scales)
     sensor = ctx.built.sensors[sensor_camera_name]
     sensor.set_camera(camera, pose)
     img = mi.render(ctx.built.scene, sensor=sensor, spp=int(spp), seed=int(seed))
@@ -196,7 +200,8 @@ def _stereo(ctx: _Context, left: str, right: str, *, encode_image, spp: int, see
     out = {"left_view": left, "right_view": right, "dir": base}
     truths = {}
     for side, pose in (("left", rect.cam_left_from_world), ("right", rect.cam_right_from_world)):
-        lin = _render_rectified(ctx, ctx.views[left].camera, rc, pose, spp=spp, seed=_seed(seed, left, side))
+        lin = _render_rectified(ctx, ctx.views[left].camera, rc, pose, spp=spp, seed=_seed(seed, left, side),
+                                light_scales=ctx.views[left].light_scales)  # both sides: the left view's lighting
         ctx.write(f"{base}/{side}.png", sio.encode_png(encode_image(lin)))
         ctx.write(f"{base}/{side}_linear.exr", sio.encode_exr(sio.pack_channels("", lin, "RGB")))
         t = ctx._truth_pass(ctx.built.scene, rc, pose, ctx.built.id_tables)

@@ -13,6 +13,9 @@ Conventions (docs/crossview.md):
   norm (H&Z eq. 9.1 up to scale).
 * Epipole ``e_i`` = image of camera j's centre in view i (undistorted pixels), ``F e_i = 0``;
   ``e_j`` = image of camera i's centre in view j, ``F^T e_j = 0``. Homogeneous, unit norm.
+* Zero baseline (a pure rotation, or the same pose: the camera centres closer than
+  :data:`ZERO_BASELINE_M`): E, F and the epipoles do not exist and are None (JSON null); every
+  plane's homography is then the infinite homography ``K_j R K_i^-1``.
 * Plane homography for a plane ``{X_i : n_i . X_i = d_i}`` (unit normal, d_i > 0 or < 0 in
   camera i's frame): ``H = K_j (R + t n_i^T / d_i) K_i^-1`` maps undistorted pixels of i to those
   of j for points on the plane (H&Z eq. 13.2). Scaled so that H[2, 2] = 1 when possible.
@@ -24,6 +27,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from scenegen.pose import Rigid3
+
+#: Camera centres closer than this (metres) are one centre: no epipolar geometry. Far above the
+#: rounding of float64 poses at metre scale (~1e-16 m), far below any real baseline.
+ZERO_BASELINE_M = 1e-9
 
 
 def relative_pose(cam_i_from_world: Rigid3, cam_j_from_world: Rigid3) -> Rigid3:
@@ -108,19 +115,23 @@ class TwoView:
     """Two-view geometry of views i -> j (see the module docstring for conventions)."""
 
     j_from_i: Rigid3  # X_j = R X_i + t, metres
-    E: np.ndarray  # (3, 3) essential, normalised coordinates
-    F: np.ndarray  # (3, 3) fundamental, undistorted pixels, unit Frobenius norm
-    epipole_i: np.ndarray  # (3,) homogeneous, undistorted pixels of i
-    epipole_j: np.ndarray  # (3,) homogeneous, undistorted pixels of j
+    E: np.ndarray | None  # (3, 3) essential, normalised coordinates; None for a zero baseline
+    F: np.ndarray | None  # (3, 3) fundamental, undistorted pixels, unit Frobenius norm; likewise
+    epipole_i: np.ndarray | None  # (3,) homogeneous, undistorted pixels of i; likewise
+    epipole_j: np.ndarray | None  # (3,) homogeneous, undistorted pixels of j; likewise
 
     @classmethod
     def of(cls, camera_i, cam_i_from_world: Rigid3, camera_j, cam_j_from_world: Rigid3) -> "TwoView":
         rel = relative_pose(cam_i_from_world, cam_j_from_world)
+        if np.linalg.norm(rel.t) < ZERO_BASELINE_M:  # one centre: F = 0 / 0
+            return cls(rel, None, None, None, None)
         e_i, e_j = epipoles(camera_i.K, camera_j.K, rel)
         return cls(rel, essential(rel), fundamental(camera_i.K, camera_j.K, rel), e_i, e_j)
 
     def to_dict(self) -> dict:
+        lst = lambda a: None if a is None else a.tolist()
+        px = lambda e: None if e is None else epipole_pixel(e)
         return {"j_from_i": self.j_from_i.to_dict(), "baseline_m": float(np.linalg.norm(self.j_from_i.t)),
-                "E": self.E.tolist(), "F": self.F.tolist(),
-                "epipole_i": self.epipole_i.tolist(), "epipole_j": self.epipole_j.tolist(),
-                "epipole_i_px": epipole_pixel(self.epipole_i), "epipole_j_px": epipole_pixel(self.epipole_j)}
+                "E": lst(self.E), "F": lst(self.F),
+                "epipole_i": lst(self.epipole_i), "epipole_j": lst(self.epipole_j),
+                "epipole_i_px": px(self.epipole_i), "epipole_j_px": px(self.epipole_j)}

@@ -8,6 +8,7 @@ UVs pass through unchanged (checked in tests/test_render.py).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import mitsuba as mi
@@ -38,6 +39,9 @@ class BuiltScene:
     moving: list = field(default_factory=list)  # objects that move during the exposure (_Moving)
     motion_subframes: int = 1
     objects: list = field(default_factory=list)  # [{name, object_id, instance_id, kind}] for cameras.json
+    emitters: list = field(default_factory=list)  # per spec light, spec order: (Mitsuba key of
+    # its power, loaded value = spec power, key of its sampling weight, loaded weight)
+    light_scales: tuple = ()  # factor on each spec light's power now in the loaded scene
 
 
 @dataclass
@@ -219,6 +223,60 @@ def light_entry(light, world_up=(0.0, 0.0, 1.0)) -> dict:
     raise TypeError(f"unknown light {type(light).__name__}")
 
 
+#: Mitsuba 3.9 parameters (relative to the light's key in the scene dict) that carry a light's
+#: power: scaling one scales the light's contribution linearly (same paths, same samples).
+EMITTER_POWER_PARAM = {
+    m.AreaLight: "emitter.radiance.value",  # the rectangle's area emitter, W/(m^2 sr)
+    m.PointLight: "intensity.value",  # W/sr
+    m.SpotLight: "intensity.value",  # on-axis W/sr
+    m.ConstantLight: "radiance.value",  # W/(m^2 sr)
+    m.EnvmapLight: "scale",  # factor on the image's radiance
+}
+#: ... and its share of the light samples: Mitsuba picks the emitter of a light sample in
+#: proportion to this weight (1 by default), not to power.
+EMITTER_WEIGHT_PARAM = {t: ("emitter." if t is m.AreaLight else "") + "sampling_weight"
+                        for t in EMITTER_POWER_PARAM}
+
+
+def _sampling_weights(built: BuiltScene, scales: tuple) -> tuple:
+    """Lights that are off get no light samples (as if absent: 6 lights with 5 off would
+    otherwise waste 5/6 of them); when every light is off the loaded weights stay."""
+    if not any(k > 0 for k in scales):
+        return tuple(e[3] for e in built.emitters)
+    return tuple(e[3] if k > 0 else 0.0 for e, k in zip(built.emitters, scales))
+
+
+def set_lighting(built: BuiltScene, light_scales=None) -> None:
+    """Put the loaded scene's lights at ``light_scales`` x their spec power (one factor per spec
+    light, spec order; None = every light at its spec power).
+
+    Parameters are touched only for lights whose factor differs from the scene's current state,
+    so a spec that never changes its lighting renders exactly as loaded; each factor multiplies
+    the loaded value, so going back to 1 restores it bit for bit and the result does not depend
+    on the order in which views are rendered. A light at 0 stays in the scene as geometry (an
+    area light's rectangle is still there, dark) but gets no light samples; lights on keep
+    theirs, so scaling lights that stay on changes no sample (a factor of 2 doubles the image
+    exactly)."""
+    n = len(built.emitters)
+    target = (1.0,) * n if light_scales is None else tuple(float(k) for k in light_scales)
+    if len(target) != n:
+        raise ValueError(f"expected {n} light factors (one per spec light), got {len(target)}")
+    if not all(math.isfinite(k) and k >= 0 for k in target):
+        raise ValueError(f"light factors must be finite and >= 0, got {target}")
+    if target == built.light_scales:
+        return
+    params = mi.traverse(built.scene)
+    weights_now, weights = _sampling_weights(built, built.light_scales), _sampling_weights(built, target)
+    for (key, loaded, wkey, _), k, now, w, w_now in zip(built.emitters, target, built.light_scales,
+                                                         weights, weights_now):
+        if k != now:
+            params[key] = loaded * k
+        if w != w_now:
+            params[wkey] = w
+    params.update()
+    built.light_scales = target
+
+
 def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) -> BuiltScene:
     """Load ``spec`` into Mitsuba (current variant) with one of our sensors per spec camera."""
     sensor_mod.register()
@@ -245,6 +303,15 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
         timed = shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
         d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler, name=name, timed=timed)
     built.scene = mi.load_dict(d)
+    if spec.lights:
+        params = mi.traverse(built.scene)
+        for i, light in enumerate(spec.lights):
+            key = f"light_{i:04d}.{EMITTER_POWER_PARAM[type(light)]}"
+            wkey = f"light_{i:04d}.{EMITTER_WEIGHT_PARAM[type(light)]}"
+            loaded = params[key]
+            # copies: the parameter objects are replaced on update
+            built.emitters.append((key, type(loaded)(loaded), wkey, float(params[wkey])))
+        built.light_scales = (1.0,) * len(spec.lights)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
     return built
@@ -282,14 +349,17 @@ def place_moving_objects(built: BuiltScene, tau_s: float) -> None:
 
 
 def render_view(built: BuiltScene, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int,
-                motion=None) -> np.ndarray:
+                motion=None, light_scales=None) -> np.ndarray:
     """Linear float32 (H, W, 3) radiance of one view, with the camera's lens and time effects.
 
-    ``cam_from_world`` is the mid-exposure pose; ``motion`` the camera's own velocities. Moving
+    ``cam_from_world`` is the mid-exposure pose; ``motion`` the camera's own velocities;
+    ``light_scales`` the factor on each spec light's power (:func:`set_lighting`; None = every
+    light at its spec power, whatever an earlier view used). Moving
     objects are rendered in ``built.motion_subframes`` sub-frames (each a slice of the shutter
     interval, with spp / sub-frames samples) and averaged; they are left at mid-exposure, where
     the truth is cast. Chromatic aberration renders each colour channel with its own camera.
     """
+    set_lighting(built, light_scales)
     camera = built.cameras[camera_name]
     optics = built.optics.get(camera_name)
     sensor = built.sensors[camera_name]

@@ -51,10 +51,6 @@ def derive_seed(scene_seed: int, field_path: str) -> int:
     return int(ss.generate_state(1)[0])
 
 
-def _is_power_of_two(n: int) -> bool:
-    return n > 0 and n & (n - 1) == 0
-
-
 class _Parser:
     def __init__(self, doc: Document):
         self.doc = doc
@@ -90,6 +86,7 @@ class _Parser:
         _unique_names(f.get("objects"), objects, "object")
         lights = self.list_section(f, "lights", self.light)
         _unique_names(f.get("lights"), lights, "light")
+        self.lights = lights  # named by view sets' `lights:`
         view_sets = self.list_section(f, "views", self.view_set, cameras, rigs)
         crossview = self.crossview(f.get("crossview")) if "crossview" in f else None
         variation = None
@@ -203,12 +200,9 @@ class _Parser:
         if max_depth == 0:
             raise f.get("max_depth").error("expected -1 (unbounded) or a positive integer, got 0")
         sampler = f.get("sampler").as_enum(m.SAMPLERS, "sampler") if "sampler" in f else "ldsampler"
-        if sampler in ("ldsampler", "orthogonal") and not _is_power_of_two(spp):
-            self.warn(f.get("spp") or node, f"spp = {spp} is not a power of two; "
-                      f"{sampler} works best with powers of two")
-        if sampler in ("stratified", "multijitter") and math.isqrt(spp) ** 2 != spp:
-            self.warn(f.get("spp") or node, f"spp = {spp} is not a perfect square; Mitsuba's "
-                      f"{sampler} sampler rounds it up to {(math.isqrt(spp - 1) + 1) ** 2}")
+        if (n := m.effective_spp(sampler, spp)) != spp:
+            self.warn(f.get("spp") or node, f"spp = {spp}: Mitsuba's {sampler} rounds it up to {n} samples per "
+                      "pixel (recorded as render_used.spp_effective)")
         return m.RenderSettings(
             spp=spp, max_depth=max_depth, seed=f.int("seed", 0, lo=0, hi=_SEED_MAX),
             variant=f.get("variant").as_enum(m.RENDER_VARIANTS, "variant") if "variant" in f
@@ -711,7 +705,7 @@ class _Parser:
         f = node.as_mapping("a view set (camera or rig, and one of orbit, look_at, poses, "
                             "random, path)")
         placements = ("orbit", "look_at", "poses", "random", "path")
-        f.check(optional=("name", "camera", "rig", "motion") + placements)
+        f.check(optional=("name", "camera", "rig", "motion", "lights") + placements)
         name = f.get("name").as_name("a view set name") if "name" in f else None
         who = f.one_of(("camera", "rig"))
         camera = rig = None
@@ -730,7 +724,47 @@ class _Parser:
                  "random": self.random, "path": self.path}[kind]
         placement = parse(pn, "rig" if rig else "cam")
         return m.ViewSet(name=name, camera=camera, rig=rig, placement=placement,
-                         motion=self.motion(f.get("motion")) if "motion" in f else None, where=node.where)
+                         motion=self.motion(f.get("motion")) if "motion" in f else None,
+                         lights=self.view_lights(f.get("lights")) if "lights" in f else None,
+                         where=node.where)
+
+    def view_lights(self, node: Node):
+        """A view set's ``lights``: a list of names (those at their spec power, the others off)
+        or a mapping name -> factor >= 0 (unnamed lights off). Returns every spec light, in
+        spec order, with its factor."""
+        names = [light.name for light in self.lights]
+        if not names:
+            raise node.error("the spec defines no lights (add a 'lights:' section); 'lights' on a "
+                             "view set switches and scales the spec's lights")
+
+        def known(name_node: Node, name: str) -> str:
+            if name not in names:
+                raise name_node.error(f"undefined light {name!r}{suggest(name, names)}; "
+                                      f"defined under lights: {', '.join(names)}")
+            return name
+
+        given: dict[str, float] = {}
+        if node.is_sequence:
+            first: dict[str, int | None] = {}
+            for item in node.items():
+                name = known(item, item.as_str("a light name"))
+                if name in first:
+                    raise item.error(f"duplicate light {name!r} (first at line {first[name]})")
+                first[name] = item.line
+                given[name] = 1.0
+        elif node.is_mapping:
+            f = node.as_mapping()
+            for name in f.keys():
+                known(f.key_node(name), name)
+                given[name] = f.value(name).as_float("factor on the light's spec power", lo=0.0)
+        else:
+            raise node.error("expected a list of light names (on at their spec power, the others "
+                             "off) or a mapping of light names to factors >= 0, got "
+                             f"{node.describe()}")
+        if not given:
+            raise node.error("expected at least one light (an empty list or mapping would turn "
+                             "every light off; give {name: 0} to do that on purpose)")
+        return m.frozen_mapping({name: given.get(name, 0.0) for name in names})
 
     # -- lens and time effects (scenegen/optics.py, docs/image_formation.md) -------------------
     def optics(self, f, model: str):

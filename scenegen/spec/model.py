@@ -14,6 +14,8 @@ Paths to files (meshes, images) are absolute, resolved relative to the spec file
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -29,6 +31,32 @@ _WHERE = dict(default=None, compare=False, repr=False)
 #: Allowed values of the enumerations, in the order the docs list them.
 RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 SAMPLERS = ("ldsampler", "multijitter", "stratified", "orthogonal", "independent")
+
+
+def effective_spp(sampler: str, spp: int) -> int:
+    """Samples per pixel Mitsuba 3.9's ``sampler`` actually takes when asked for ``spp`` (its
+    plugins round the count up; tested against ``mi.load_dict(...).sample_count()`` in
+    tests/test_render.py): ``ldsampler`` to a power of 4 (at least 4), ``orthogonal`` to the
+    square of a prime, ``stratified`` to a square, ``multijitter`` to ``m * ceil(spp / m)`` with
+    ``m = floor(sqrt(spp))``, ``independent`` not at all."""
+    n = int(spp)
+    if sampler == "ldsampler":
+        k = 4
+        while k < n:
+            k *= 4
+        return k
+    if sampler == "orthogonal":
+        p = 2
+        while p * p < n or any(p % d == 0 for d in range(2, math.isqrt(p) + 1)):
+            p += 1
+        return p * p
+    if sampler == "stratified":
+        r = math.isqrt(n)
+        return r * r if r * r == n else (r + 1) ** 2
+    if sampler == "multijitter":
+        m = math.isqrt(n)
+        return m * -(-n // m)
+    return n
 BIT_DEPTHS = (8, 16)
 TEXTURE_KINDS = ("image", "checkerboard", "noise", "speckle", "natural")
 PROCEDURAL_TEXTURE_KINDS = TEXTURE_KINDS[1:]
@@ -73,7 +101,7 @@ def frozen_mapping(d: Mapping | None = None) -> Mapping:
 # render settings
 @dataclass(frozen=True, kw_only=True)
 class RenderSettings:
-    spp: int = 64  # samples per pixel; a power of two suits the default ldsampler
+    spp: int = 64  # samples per pixel asked for; Mitsuba may round it up (effective_spp)
     max_depth: int = 6  # longest light path in segments (Mitsuba max_depth; -1 = unbounded)
     seed: int = 0  # sampler seed (image noise); independent of the scene seed
     variant: str = "auto"  # one of RENDER_VARIANTS; 'auto' lets the renderer pick
@@ -455,6 +483,8 @@ class ViewSet:
     rig: str | None  # a key of `rigs:`
     placement: Placement  # where the camera (or the rig frame) goes
     motion: Any = None  # scenegen.optics.Motion of the placed camera / rig frame (body velocities)
+    lights: Mapping[str, float] | None = None  # illumination of this view set: every spec light
+    # (spec order) -> factor (>= 0) on its spec power, 0 = off; None = every light at its power
     where: Where | None = field(**_WHERE)
 
     @property
@@ -474,6 +504,8 @@ class View:
     frame_index: int = 0  # placement counter over all view sets; a rig's members share it
     view_set: int = 0  # index of the view set in `views:`
     motion: Any = None  # scenegen.optics.Motion of this camera, in its own frame; None = static
+    light_scales: tuple[float, ...] | None = None  # factor on each spec light's power (spec
+    # order; 0 = off) from the view set's `lights:`; None = every light at its spec power
 
 
 # ---------------------------------------------------------------------------------------------

@@ -95,7 +95,7 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         "lights": _plain(spec.lights),
         "cameras": cameras,
         "rigs": _plain(spec.rigs),
-        "view_sets": _plain(spec.view_sets),
+        "view_sets": _view_sets(spec.view_sets),
         "views": views,
         # only when declared, so that specs without variation keep their hashes
         **({"variation": _plain(spec.variation)} if spec.variation is not None else {}),
@@ -103,6 +103,17 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         **({"crossview": _plain(spec.crossview)} if getattr(spec, "crossview", None) is not None else {}),
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
     }
+
+
+def _view_sets(view_sets) -> list:
+    """The view sets; ``lights`` only where given, so specs without it keep their hashes."""
+    out = []
+    for vs in view_sets:
+        d = _plain(vs)
+        if d.get("lights") is None:
+            d.pop("lights", None)
+        out.append(d)
+    return out
 
 
 def _rounded(x):

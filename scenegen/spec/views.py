@@ -37,11 +37,12 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
     views: list[m.View] = []
     frame = 0
     for set_index, (vs, poses) in enumerate(zip(spec.view_sets, per_set)):
+        scales = view_set_light_scales(spec, vs)
         for world_from_x in poses:
             if vs.camera is not None:
                 views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
                                     cam_from_world=world_from_x.inverse(), frame_index=frame,
-                                    view_set=set_index, motion=vs.motion))
+                                    view_set=set_index, motion=vs.motion, light_scales=scales))
             else:
                 rig = spec.rigs[vs.rig]
                 for member in rig.members:
@@ -50,9 +51,24 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
                         cam_from_world=world_from_cam.inverse(), rig=rig.name,
                         rig_member=member.name, frame_index=frame, view_set=set_index,
-                        motion=_member_motion(vs.motion, member.rig_from_cam)))
+                        motion=_member_motion(vs.motion, member.rig_from_cam), light_scales=scales))
             frame += 1
     return tuple(views)
+
+
+def view_set_light_scales(spec: m.SceneSpec, vs: m.ViewSet) -> tuple[float, ...] | None:
+    """The view set's factor on each spec light's power, in spec order (0 = off; a light its
+    ``lights`` does not name is off), or None when it has no ``lights`` (every light at 1)."""
+    if vs.lights is None:
+        return None
+    return tuple(float(vs.lights.get(light.name, 0.0)) for light in spec.lights)
+
+
+def light_scales_dict(spec: m.SceneSpec, scales: tuple[float, ...] | None) -> dict[str, float]:
+    """{light name: factor} for every spec light, in spec order (None = every light at 1)."""
+    if scales is None:
+        scales = (1.0,) * len(spec.lights)
+    return {light.name: float(k) for light, k in zip(spec.lights, scales)}
 
 
 def _placement_poses(vs: m.ViewSet) -> list[Rigid3]:

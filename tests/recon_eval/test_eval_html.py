@@ -135,3 +135,23 @@ def test_no_matplotlib_at_import():
     code = ("import sys, recon_eval.cli, recon_eval.html_report\n"
             "assert 'matplotlib' not in sys.modules, 'matplotlib imported eagerly'\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_reports_get_the_usual_file_permissions(tmp_path):
+    """JSON and HTML reports are written atomically with 0o666 minus the umask, like any file (a
+    bare mkstemp would leave them readable by their owner only)."""
+    import os
+
+    from recon_eval.html_report import write_html_atomic
+    from recon_eval.report import write_json_atomic
+
+    old = os.umask(0o022)
+    try:
+        write_json_atomic(tmp_path / "r.json", {"a": 1})
+        write_html_atomic(tmp_path / "r.html", "<!DOCTYPE html>")
+    finally:
+        os.umask(old)
+    for name in ("r.json", "r.html"):
+        assert (tmp_path / name).stat().st_mode & 0o777 == 0o644
+    assert (tmp_path / "r.json").read_text() == '{\n  "a": 1\n}\n'
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary file left
