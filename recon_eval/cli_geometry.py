@@ -170,7 +170,8 @@ def _cmd_triangulation_task(a):
     if a.count < 1:
         raise InputError(f"--count must be >= 1, got {a.count}")
     ds = read_dataset(a.dataset)
-    pairs = [tt.build_pair(ds, v1, v2, a.sigma, a.count, a.seed) for v1, v2 in tt.dataset_pairs(ds, a.pairs)]
+    views, skipped = tt.dataset_pairs(ds, a.pairs)
+    pairs = [tt.build_pair(ds, v1, v2, a.sigma, a.count, a.seed) for v1, v2 in views]
     path = tt.write_task(a.out, pairs, {"dataset": str(a.dataset), "scene": scene_name(ds), "sigma_px": a.sigma,
                                         "seed": a.seed, "count": a.count})
     from recon_eval.triangulation import triangulation_angle_deg
@@ -178,8 +179,8 @@ def _cmd_triangulation_task(a):
     res = {"pairs": {tp.name: {"n_points": len(tp.points_true), "median_angle_deg": float(np.median(
         triangulation_angle_deg(tp.points_true, -tp.cam1_from_world[0].T @ tp.cam1_from_world[1],
                                 -tp.cam2_from_world[0].T @ tp.cam2_from_world[1])))} for tp in pairs}}
-    return {"dataset": a.dataset, "task": str(path), "sigma_px": a.sigma, "seed": a.seed, "count": a.count}, res, \
-        _no_figures
+    return {"dataset": a.dataset, "task": str(path), "sigma_px": a.sigma, "seed": a.seed, "count": a.count,
+            "skipped_zero_baseline_pairs": [f"{i}:{j}" for i, j in skipped]}, res, _no_figures
 
 
 def _bins_table(score) -> dict:

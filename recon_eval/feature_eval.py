@@ -31,11 +31,11 @@ from recon_eval.features import (
     MatchingScore,
     MatchPrecisionRecall,
     Repeatability,
+    check_match_indices,
     match_accuracy,
     match_precision_recall,
     matching_score,
     mean_over_pairs,
-    _match_indices,
     read_correspondence_map,
     repeatability,
 )
@@ -195,7 +195,7 @@ def score_pair(kp_i, kp_j, matches, map_ij: CorrespondenceMap, map_ji: Correspon
     """Every metric of one pair: keypoints ``kp_i`` (N, 2), ``kp_j`` (K, 2) OpenCV px, putative
     ``matches`` (M, 2) int indices (i -> j)."""
     kp_i, kp_j = np.asarray(kp_i, np.float64).reshape(-1, 2), np.asarray(kp_j, np.float64).reshape(-1, 2)
-    mt = _match_indices(matches, len(kp_i), len(kp_j))
+    mt = check_match_indices(matches, len(kp_i), len(kp_j))
     return PairScore(description, len(kp_i), len(kp_j),
                      repeatability(kp_i, kp_j, map_ij, map_ji, eps_px),
                      match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij),

@@ -196,7 +196,7 @@ def matching_score(kp_i, kp_j, matches, map_ij: CorrespondenceMap, map_ji: Corre
     truth in the other view."""
     kp_i = as_float_array(kp_i, "kp_i", (None, 2))
     kp_j = as_float_array(kp_j, "kp_j", (None, 2))
-    mt = _match_indices(matches, len(kp_i), len(kp_j))
+    mt = check_match_indices(matches, len(kp_i), len(kp_j))
     acc = match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij, (eps_px,))
     ok_i = map_keypoints(kp_i, map_ij)[1]
     ok_j = map_keypoints(kp_j, map_ji)[1]
@@ -206,7 +206,7 @@ def matching_score(kp_i, kp_j, matches, map_ij: CorrespondenceMap, map_ji: Corre
     return MatchingScore(float(eps_px), n_correct / den if den else float("nan"), n_correct, n_i, n_j)
 
 
-def _match_indices(matches, n_i: int, n_j: int) -> np.ndarray:
+def check_match_indices(matches, n_i: int, n_j: int) -> np.ndarray:
     """(M, 2) int64 indices, checked against the keypoint counts."""
     mt = np.asarray(matches)
     if mt.size == 0:
@@ -235,7 +235,7 @@ def match_precision_recall(kp_i, kp_j, matches, map_ij: CorrespondenceMap,
     ``kp_j`` (K, 2), OpenCV pixels, against the truth map i -> j (module docstring)."""
     kp_i = as_float_array(kp_i, "kp_i", (None, 2))
     kp_j = as_float_array(kp_j, "kp_j", (None, 2))
-    mt = _match_indices(matches, len(kp_i), len(kp_j))
+    mt = check_match_indices(matches, len(kp_i), len(kp_j))
     acc = match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij, (eps_px,))
     correct = acc.dist_px <= eps_px
     m, ok = map_keypoints(kp_i, map_ij)

@@ -103,24 +103,48 @@ def build_pair(ds, view1: str, view2: str, sigma_px: float, count: int = DEFAULT
     return TaskPair(name, view1, view2, P1, P2, x, X, (p1.R.copy(), p1.t.copy()), (p2.R.copy(), p2.t.copy()))
 
 
-def dataset_pairs(ds, pairs=None) -> list:
-    """[(view1, view2)]: ``pairs`` given as ``"V1:V2"`` strings, else the pairs of the dataset's
-    crossview/index.json."""
+def baseline_m(ds, view1: str, view2: str) -> float:
+    """Distance (metres) between the two views' camera centres."""
+    from scenegen.pose import camera_center
+
+    (_, p1), (_, p2) = ds.camera(view1), ds.camera(view2)
+    return float(np.linalg.norm(camera_center(p1) - camera_center(p2)))
+
+
+def dataset_pairs(ds, pairs=None) -> tuple[list, list]:
+    """``([(view1, view2)], skipped)``: the pairs given as ``"V1:V2"`` strings, else those of the
+    dataset's crossview/index.json. Two views with one camera centre (a roll about the optical
+    axis, an illumination pair; closer than ``scenegen.crossview.twoview.ZERO_BASELINE_M``) have
+    no triangulation: such a pair given by name is an error, one from the index is left out and
+    listed in ``skipped``."""
+    from scenegen.crossview.twoview import ZERO_BASELINE_M
+
     if pairs:
         out = []
         for s in pairs:
             parts = s.split(":")
             if len(parts) != 2 or not all(parts):
                 raise InputError(f"--pairs: expected VIEW1:VIEW2, got {s!r}")
-            out.append((ds._check_view(parts[0]), ds._check_view(parts[1])))
-        return out
+            v1, v2 = ds._check_view(parts[0]), ds._check_view(parts[1])
+            if v1 != v2 and baseline_m(ds, v1, v2) < ZERO_BASELINE_M:  # (a view with itself: build_pair)
+                raise InputError(f"--pairs {s}: the two views share one camera centre (zero baseline): "
+                                 "nothing can be triangulated")
+            out.append((v1, v2))
+        return out, []
     from recon_eval.runners._common import crossview_index
 
     idx = crossview_index(ds)
     if not idx or not idx.get("pairs"):
         raise InputError(f"{ds.root}: no view pairs given (--pairs V1:V2 ...) and no crossview pairs "
                          f"(crossview/index.json: pairs)")
-    return [(ds._check_view(p["i"]), ds._check_view(p["j"])) for p in idx["pairs"]]
+    out, skipped = [], []
+    for p in idx["pairs"]:
+        v1, v2 = ds._check_view(p["i"]), ds._check_view(p["j"])
+        (skipped if baseline_m(ds, v1, v2) < ZERO_BASELINE_M else out).append((v1, v2))
+    if not out:
+        raise InputError(f"{ds.root / 'crossview' / 'index.json'}: pairs: every pair has a zero baseline "
+                         "(one camera centre): nothing can be triangulated")
+    return out, skipped
 
 
 def _table_bytes(a: np.ndarray, header: str) -> bytes:

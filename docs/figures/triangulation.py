@@ -30,7 +30,7 @@ SEED = 0
 
 def score(dataset: Path, work: Path, sigma: float):
     ds = read_dataset(dataset)
-    pairs = [tt.build_pair(ds, v1, v2, sigma, COUNT, SEED) for v1, v2 in tt.dataset_pairs(ds)]
+    pairs = [tt.build_pair(ds, v1, v2, sigma, COUNT, SEED) for v1, v2 in tt.dataset_pairs(ds)[0]]
     tt.write_task(work / "task", pairs, {"dataset": str(dataset), "sigma_px": sigma, "seed": SEED, "count": COUNT})
     _, pairs = tt.read_task(work / "task")
     for tp in pairs:

@@ -12,6 +12,7 @@ relative error: float precision), and the median error per triangulation-angle b
 """
 from __future__ import annotations
 
+from recon_eval.errors import InputError
 from recon_eval.runners._common import NotApplicable, RunOutput, crossview_index
 
 SIGMAS_PX = (0.0, 1.0)
@@ -30,7 +31,10 @@ def opencv(ds, out_dir, options) -> RunOutput:
     if not idx or not idx.get("pairs"):
         raise NotApplicable(f"{ds.root}: no cross-view pairs (crossview/index.json: pairs)")
     out = RunOutput()
-    views = tt.dataset_pairs(ds)
+    try:
+        views, skipped = tt.dataset_pairs(ds)
+    except InputError as exc:  # e.g. only zero-baseline pairs
+        raise NotApplicable(str(exc)) from None
     for sigma in SIGMAS_PX:
         tag = _sigma_tag(sigma)
         pairs = [tt.build_pair(ds, v1, v2, sigma, COUNT, SEED) for v1, v2 in views]
@@ -53,5 +57,6 @@ def opencv(ds, out_dir, options) -> RunOutput:
             if b.n:
                 out.metrics[f"{tag}.{tt.bin_label(b)}.median_err_m"] = b.median_m
         out.notes[tag] = {"pairs": [tp.name for tp in pairs], "points": int(pooled.n_points), **notes}
-    out.notes.update({"count_per_pair": COUNT, "seed": SEED, "sigmas_px": list(SIGMAS_PX)})
+    out.notes.update({"count_per_pair": COUNT, "seed": SEED, "sigmas_px": list(SIGMAS_PX),
+                      "skipped_zero_baseline_pairs": [f"{i}:{j}" for i, j in skipped]})
     return out

@@ -51,3 +51,36 @@ def write_colmap(d, qs, ts):
     (d / "images.txt").write_text("\n".join(lines) + "\n")
     # point 1 is observed by image 2's second keypoint (its POINTS2D line references point 1)
     (d / "points3D.txt").write_text("# pts\n1 0.1 0.2 3.0 255 0 0 0.5 2 1\n")
+
+
+#: A poster and a blob seen from a reference view, the same view rolled about its optical axis
+#: (one camera centre: no epipolar geometry, nothing to triangulate) and a view 0.6 m to the side;
+#: crossview pairs [ref, rolled] and [ref, side] with labelled match sets.
+ZERO_BASELINE_SPEC = """
+name: zero_baseline_runs
+seed: 5
+render: {spp: 4, max_depth: 2}
+objects:
+  - name: poster
+    shape: {type: plane, size: [1.6, 1.2]}
+    transform: {translation: [0, 0.6, 0.7], rotation_deg: [90, 0, 0]}
+    material: {type: diffuse, texture: {type: natural, params: {size_px: 256}}}
+  - name: rock
+    shape: {type: blob, radius: 0.2}
+    transform: {translation: [0.1, 0.1, 0.5]}
+lights:
+  - {type: constant, radiance: 1.0}
+cameras:
+  cam: {size: [120, 90], fx: 100}
+views:
+  - camera: cam
+    look_at:
+      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6]}
+      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6], up: [0.5, 0, 0.866]}
+      - {eye: [0.6, -1.4, 0.9], target: [0, 0.3, 0.6]}
+crossview:
+  pairs: [[cam_0000, cam_0001], [cam_0000, cam_0002]]
+  flow: false
+  targets: false
+  matches: {count: 200, sigma_px: 0.5, outlier_fraction: 0.2, seed: 3}
+"""

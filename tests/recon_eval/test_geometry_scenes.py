@@ -265,3 +265,26 @@ def test_geometry_gate_file_holds(runs, tmp_path):
                         *(str(runs[k][0] / "result.json") for k in ("dlt", "tri"))], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "5 of 5 gates hold" in r.stdout
+
+
+def test_zero_baseline_pairs_are_not_triangulated(tmp_path, capsys):
+    """A roll about the optical axis keeps the camera centre: the pair is left out of a task built
+    from the index (and listed), and naming it is an error; the runner notes it."""
+    from _recon_eval_helpers import ZERO_BASELINE_SPEC
+    from recon_eval.runners import run_method
+    from scenegen.pipeline import render_spec
+
+    (tmp_path / "zb.yaml").write_text(ZERO_BASELINE_SPEC)
+    render_spec(tmp_path / "zb.yaml", tmp_path / "ds", progress=False)
+    code, _, err = run(["triangulation-task", tmp_path / "ds", "-o", tmp_path / "task", "--json",
+                        tmp_path / "t.json", "--quiet"], capsys)
+    assert code == 0, err
+    doc = json.loads((tmp_path / "t.json").read_text())
+    assert doc["inputs"]["skipped_zero_baseline_pairs"] == ["cam_0000:cam_0001"]
+    assert list(doc["results"]["pairs"]) == ["cam_0000__cam_0002"]
+    code, _, err = run(["triangulation-task", tmp_path / "ds", "-o", tmp_path / "t2", "--pairs",
+                        "cam_0000:cam_0001"], capsys)
+    assert code == 2 and "zero baseline" in err and "Traceback" not in err
+    r = run_method("opencv-triangulate", tmp_path / "ds", tmp_path / "run")
+    assert r["inputs"]["notes"]["skipped_zero_baseline_pairs"] == ["cam_0000:cam_0001"]
+    assert r["metrics"]["sigma0.max_rel_err"] < NOISE_FREE_REL_TOL

@@ -136,42 +136,14 @@ def test_pnp_raw_output_lists_every_view(more_results):
 
 
 # --- zero-baseline pairs (a roll about the optical axis, an illumination pair) ----------------
-ZERO_BASELINE_SPEC = """
-name: zero_baseline_runs
-seed: 5
-render: {spp: 4, max_depth: 2}
-objects:
-  - name: poster
-    shape: {type: plane, size: [1.6, 1.2]}
-    transform: {translation: [0, 0.6, 0.7], rotation_deg: [90, 0, 0]}
-    material: {type: diffuse, texture: {type: natural, params: {size_px: 256}}}
-  - name: rock
-    shape: {type: blob, radius: 0.2}
-    transform: {translation: [0.1, 0.1, 0.5]}
-lights:
-  - {type: constant, radiance: 1.0}
-cameras:
-  cam: {size: [120, 90], fx: 100}
-views:
-  - camera: cam
-    look_at:
-      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6]}
-      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6], up: [0.5, 0, 0.866]}
-      - {eye: [0.6, -1.4, 0.9], target: [0, 0.3, 0.6]}
-crossview:
-  pairs: [[cam_0000, cam_0001], [cam_0000, cam_0002]]
-  flow: false
-  targets: false
-  matches: {count: 200, sigma_px: 0.5, outlier_fraction: 0.2, seed: 3}
-"""
-
-
 def test_f_and_e_runners_skip_zero_baseline_pairs(tmp_path):
     """The rolled view shares the reference's centre: its twoview truth has no F or E
     (crossview.md), so the F and E runners skip it with a note and score the other pair."""
     from scenegen.pipeline import render_spec
     from recon_eval.runners import run_method
     from recon_eval.runners.twoview import ZERO_BASELINE_NOTE
+
+    from _recon_eval_helpers import ZERO_BASELINE_SPEC
 
     (tmp_path / "zb.yaml").write_text(ZERO_BASELINE_SPEC)
     render_spec(tmp_path / "zb.yaml", tmp_path / "ds", progress=False)
