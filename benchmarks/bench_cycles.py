@@ -74,9 +74,11 @@ def main(argv=None) -> int:
     mi = load_mitsuba("auto")
     import drjit as dr
 
-    from scenegen import io as sio
-    from scenegen.conventions import blender_matrix_world
-    from scenegen.render.scene import build_scene, render_view, texture_image
+    from scenegen.dataset import codecs as sio
+    from scenegen.geometry.conventions import blender_matrix_world
+    from scenegen.assets.meshes import texture_image
+    from scenegen.render.frames import render_view
+    from scenegen.render.scene import build_scene
     from scenegen.spec import parse_spec, resolve_views
 
     W, H = args.size

@@ -42,8 +42,9 @@ def main(argv=None) -> int:
     mi = load_mitsuba("auto")
     import drjit as dr
 
-    from scenegen.camera import Camera
-    from scenegen.render.scene import build_scene, render_view
+    from scenegen.geometry.camera import Camera
+    from scenegen.render.frames import render_view
+    from scenegen.render.scene import build_scene
     from scenegen.render.truth import camera_rays, truth_pass
     from scenegen.spec import load_spec, parse_spec, resolve_views
 

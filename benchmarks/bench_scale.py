@@ -50,7 +50,7 @@ def write_spec(folder: Path, name: str, *, n: int, w: int, h: int, spp: int) -> 
 
 def bench_rss(folder: Path, frames: int) -> None:
     """The full pipeline (render, truth, encode, atomic writes, manifest) over many frames."""
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     spec = write_spec(folder, "rss", n=frames, w=64, h=48, spp=4)
     samples: list[tuple[float, float, int]] = []  # (seconds, RSS MB, views complete)
@@ -114,8 +114,8 @@ def bench_manifest(folder: Path, views: int) -> None:
 
 
 def bench_throughput(folder: Path, frames: int, w: int, h: int, spp: int) -> None:
-    from scenegen.distributed import open_client
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.distributed import open_client
+    from scenegen.pipeline.run import render_spec
     import drjit as dr  # main() has called load_mitsuba, which sets the libLLVM first
 
     spec = write_spec(folder, "tput", n=frames, w=w, h=h, spp=spp)

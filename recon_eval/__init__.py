@@ -4,7 +4,7 @@ Every metric is a pure function returning a frozen dataclass whose field names c
 (``rot_err_deg``, ``rmse_m``, ``tau_m``) and provenance (alignment, distance definition, comparison
 operator). Definitions follow the reference benchmarks as summarised in ``docs/metrics.md``.
 
-Conventions (shared with :mod:`scenegen.conventions`): OpenCV camera axes (+x right, +y down,
+Conventions (shared with :mod:`scenegen.geometry.conventions`): OpenCV camera axes (+x right, +y down,
 +z forward); poses are ``cam_from_world`` pairs ``(R (3, 3), t (3,))`` with
 ``x_cam = R @ x_world + t``; metres; radians inside, degrees only in result fields named ``*_deg``;
 pixel centre of the top-left pixel at (0, 0).

@@ -5,7 +5,7 @@ Definitions: shared/notes/metrics.md, "Calibration and PnP". Distortion coeffici
 compared one by one (they are correlated; OpenCV's own test leaves that check commented out):
 the projection difference field compares what the models *do*, across model families.
 
-Camera objects are duck-typed (``scenegen.camera.Camera`` satisfies it): ``width``, ``height``,
+Camera objects are duck-typed (``scenegen.geometry.camera.Camera`` satisfies it): ``width``, ``height``,
 ``K`` (3, 3), ``project(points_cam (N, 3)) -> (N, 2)`` pixels (NaN where invalid), and
 ``unproject(pixels (N, 2)) -> (N, 3)`` points on z = 1 (NaN where invalid); ``unproject_unit``
 (unit rays) is used when present so rays beyond 90 degrees (fisheye) are compared too.

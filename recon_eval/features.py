@@ -72,7 +72,7 @@ class CorrespondenceMap:
 
 def read_correspondence_map(path) -> CorrespondenceMap:
     """Read ``corr/<i>/<j>.exr`` (channels u, v, state; float32 u, v are widened exactly)."""
-    from scenegen import io as sio
+    from scenegen.dataset import codecs as sio
 
     try:
         ch = sio.read_exr(path)

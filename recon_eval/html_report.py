@@ -57,7 +57,7 @@ def render_html(command: str, inputs: dict, results: dict, figures: list[Figure]
 
 
 def write_html_atomic(path, text: str) -> None:
-    """Write the report atomically (:func:`scenegen.io.atomic_write`)."""
-    from scenegen.io import atomic_write_bytes
+    """Write the report atomically (:func:`scenegen.dataset.files.atomic_write`)."""
+    from scenegen.dataset.files import atomic_write_bytes
 
     atomic_write_bytes(path, text.encode("utf-8"))

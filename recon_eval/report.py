@@ -52,9 +52,9 @@ def document(command: str, inputs: dict, results: dict) -> dict:
 
 
 def write_json_atomic(path, doc: dict) -> None:
-    """Write ``doc`` to ``path`` atomically (:func:`scenegen.io.atomic_write`: a temporary file in
+    """Write ``doc`` to ``path`` atomically (:func:`scenegen.dataset.files.atomic_write`: a temporary file in
     the same directory, fsync, os.replace), so a reader never sees a half-written file."""
-    from scenegen.io import atomic_write_bytes
+    from scenegen.dataset.files import atomic_write_bytes
 
     atomic_write_bytes(path, (json.dumps(doc, indent=2, allow_nan=False) + "\n").encode("utf-8"))
 

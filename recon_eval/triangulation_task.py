@@ -105,7 +105,7 @@ def build_pair(ds, view1: str, view2: str, sigma_px: float, count: int = DEFAULT
 
 def baseline_m(ds, view1: str, view2: str) -> float:
     """Distance (metres) between the two views' camera centres."""
-    from scenegen.pose import camera_center
+    from scenegen.geometry.pose import camera_center
 
     (_, p1), (_, p2) = ds.camera(view1), ds.camera(view2)
     return float(np.linalg.norm(camera_center(p1) - camera_center(p2)))
@@ -114,10 +114,10 @@ def baseline_m(ds, view1: str, view2: str) -> float:
 def dataset_pairs(ds, pairs=None) -> tuple[list, list]:
     """``([(view1, view2)], skipped)``: the pairs given as ``"V1:V2"`` strings, else those of the
     dataset's crossview/index.json. Two views with one camera centre (a roll about the optical
-    axis, an illumination pair; closer than ``scenegen.crossview.twoview.ZERO_BASELINE_M``) have
+    axis, an illumination pair; closer than ``scenegen.geometry.twoview.ZERO_BASELINE_M``) have
     no triangulation: such a pair given by name is an error, one from the index is left out and
     listed in ``skipped``."""
-    from scenegen.crossview.twoview import ZERO_BASELINE_M
+    from scenegen.geometry.twoview import ZERO_BASELINE_M
 
     if pairs:
         out = []
@@ -156,7 +156,7 @@ def _table_bytes(a: np.ndarray, header: str) -> bytes:
 def write_task(task_dir, pairs: list, settings: dict) -> Path:
     """Write the task folder (module docstring); ``settings`` (dataset, sigma_px, seed, count...) go
     to task.json as they are. Every file is written atomically. Returns the task.json path."""
-    from scenegen.io import atomic_write_bytes
+    from scenegen.dataset.files import atomic_write_bytes
 
     root = Path(task_dir)
     root.mkdir(parents=True, exist_ok=True)
@@ -240,7 +240,7 @@ def reference_points(tp: TaskPair) -> np.ndarray:
 
 def write_points(path, points) -> None:
     """An answer file: one ``X Y Z`` row per point (17 significant digits), atomically."""
-    from scenegen.io import atomic_write_bytes
+    from scenegen.dataset.files import atomic_write_bytes
 
     atomic_write_bytes(path, _table_bytes(points, "X Y Z: triangulated points (world frame, metres)"))
 

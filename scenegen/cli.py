@@ -11,6 +11,15 @@ import sys
 import warnings
 from pathlib import Path
 
+from scenegen.dataset import Dataset, DatasetError, verify
+from scenegen.errors import SpecError
+from scenegen.export import FORMATS, export
+from scenegen.pipeline.batch import render_many
+from scenegen.pipeline.run import render_spec
+from scenegen.render import BackendError
+from scenegen.spec import load_spec, resolve_views
+from scenegen.spec.model import RENDER_VARIANTS
+
 EXIT_BAD_INPUT = 2
 
 
@@ -26,8 +35,6 @@ class _Parser(argparse.ArgumentParser):
 
 
 def cmd_validate(args) -> int:
-    from scenegen.spec import load_spec, resolve_views
-
     spec = load_spec(args.spec)
     views = resolve_views(spec)
     for name, cam in spec.cameras.items():
@@ -40,16 +47,12 @@ def cmd_validate(args) -> int:
 
 
 def cmd_render(args) -> int:
-    from scenegen.pipeline import render_spec
-
     many = args.variants is not None or args.workers is not None or args.scheduler is not None
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         kw = dict(frames=args.frames, spp=args.spp, seed=args.seed, variant=args.variant,
                   resume=args.resume, progress=not args.quiet)
         if many:  # variants and/or Dask workers (scenegen/batch.py)
-            from scenegen.batch import render_many
-
             summaries = render_many(args.spec, args.output, variants=args.variants,
                                     workers=args.workers, scheduler=args.scheduler, **kw)
         else:
@@ -69,8 +72,6 @@ def _print_summary(s) -> None:
 
 
 def cmd_info(args) -> int:
-    from scenegen.dataset import Dataset
-
     d = Dataset(args.dataset)
     m = d.manifest
     print(f"{args.dataset}: {m['format']} v{m['format_version']}, variant {m['variant']}, seed {m['seed']}")
@@ -86,8 +87,6 @@ def cmd_info(args) -> int:
 
 
 def cmd_export(args) -> int:
-    from scenegen.export import export
-
     s = export(args.dataset, args.format, args.output)
     extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
     print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
@@ -95,13 +94,11 @@ def cmd_export(args) -> int:
 
 
 def cmd_verify(args) -> int:
-    from scenegen.dataset import verify
-
     r = verify(args.dataset)
     if args.json:
-        print(json.dumps(r.to_dict() if hasattr(r, "to_dict") else r.__dict__, indent=2, default=list))
+        print(json.dumps(r.__dict__, indent=2, default=list))
     else:
-        print(r.summary() if hasattr(r, "summary") else r)
+        print(r.summary())
     return 0 if r.ok else 1
 
 
@@ -117,7 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--frames", help="frame indices to render, e.g. '0-9,12' (default: all)")
     r.add_argument("--spp", type=int, help="samples per pixel (overrides the spec)")
     r.add_argument("--seed", type=int, help="sampler seed (overrides the spec)")
-    r.add_argument("--variant", choices=("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb"))
+    r.add_argument("--variant", choices=RENDER_VARIANTS)
     r.add_argument("--resume", action="store_true", help="finish an interrupted run in the same folder")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.add_argument("--variants", type=int, metavar="N",
@@ -134,8 +131,6 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("dataset", type=Path)
     f.add_argument("--json", action="store_true")
     f.set_defaults(fn=cmd_verify)
-    from scenegen.export import FORMATS
-
     e = sub.add_parser("export", help="export a dataset to colmap, nerf, kitti-stereo, middlebury, opencv or tum")
     e.add_argument("dataset", type=Path)
     e.add_argument("--format", required=True, choices=tuple(FORMATS))
@@ -145,10 +140,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from scenegen.dataset import DatasetError
-    from scenegen.errors import SpecError
-    from scenegen.render.backend import BackendError
-
     args = build_parser().parse_args(argv)
     try:
         return args.fn(args)

@@ -25,7 +25,7 @@ OUT = ROOT / "docs/figures/features_mma.png"
 
 
 def render(spec: Path, data: Path) -> Path:
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     out = data / spec.stem
     if (out / "crossview" / "index.json").is_file():

@@ -17,7 +17,8 @@ import numpy as np
 from scenegen.imaging import apply_chain, seeds
 from scenegen.imaging.noise import SensorParams
 from scenegen.imaging.vignetting import VignettingParams
-from scenegen.pipeline import encode_image, view_seed
+from scenegen.geometry.color import srgb_image as encode_image
+from scenegen.pipeline.view import view_seed
 from scenegen.spec import load_spec, resolve_views
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -29,7 +30,8 @@ def render_linear(spec, view):
     from scenegen.render.backend import load_mitsuba
 
     load_mitsuba(spec.render.variant)
-    from scenegen.render.scene import build_scene, render_view
+    from scenegen.render.frames import render_view
+    from scenegen.render.scene import build_scene
 
     built = build_scene(spec, spp=spec.render.spp, sampler=spec.render.sampler,
                         max_depth=spec.render.max_depth)

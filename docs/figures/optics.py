@@ -66,8 +66,9 @@ PANELS = [
 
 
 def render(text: str) -> np.ndarray:
-    from scenegen.pipeline import encode_image
-    from scenegen.render.scene import build_scene, render_view
+    from scenegen.geometry.color import srgb_image as encode_image
+    from scenegen.render.frames import render_view
+    from scenegen.render.scene import build_scene
     from scenegen.spec import parse_spec, resolve_views
 
     spec = parse_spec(text, base_dir=ROOT / "scenes")

@@ -47,7 +47,7 @@ def main():
         tmp = Path(tmp)
         dataset = a.dataset
         if dataset is None:
-            from scenegen.pipeline import render_spec
+            from scenegen.pipeline.run import render_spec
 
             dataset = tmp / "data"
             s = render_spec(ROOT / "scenes/triangulation_baselines.yaml", dataset, progress=False)

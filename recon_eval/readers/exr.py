@@ -1,4 +1,4 @@
-"""OpenEXR depth and disparity maps, through :func:`scenegen.io.read_exr` (OpenEXR bindings).
+"""OpenEXR depth and disparity maps, through :func:`scenegen.dataset.codecs.read_exr` (OpenEXR bindings).
 
 A map is one channel of the file. With ``channel=None`` the reader picks, in order: the only
 channel; else the first present of :data:`DEPTH_CHANNELS` (``kind="depth"``) or
@@ -22,7 +22,7 @@ DISPARITY_CHANNELS = ("disparity", "disp", "Y", "R")
 
 def read_exr_map(path, channel: str | None = None, *, kind: str = "depth") -> np.ndarray:
     """(H, W) float64 map from an EXR file, NaN where the stored value is not finite."""
-    from scenegen.io import read_exr
+    from scenegen.dataset.codecs import read_exr
 
     p = Path(path)
     if not p.is_file():
@@ -52,7 +52,7 @@ def read_exr_map(path, channel: str | None = None, *, kind: str = "depth") -> np
 
 def write_exr_map(path, image, channel: str = "depth_z") -> None:
     """Write an (H, W) map as one float32 channel (NaN written as +inf, a miss). For tests."""
-    from scenegen.io import write_exr
+    from scenegen.dataset.codecs import write_exr
 
     a = np.asarray(image, dtype=np.float64)
     if a.ndim != 2:

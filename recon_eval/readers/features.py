@@ -12,7 +12,7 @@
 
 Pixels are OpenCV's (the centre of the top-left pixel is (0, 0)) unless ``pixel_origin="corner"``
 says that the tool puts the top-left pixel's *corner* at (0, 0) (COLMAP, VLFeat): 0.5 is then
-subtracted on reading, by :func:`scenegen.conventions.opencv_from_colmap_pixels`.
+subtracted on reading, by :func:`scenegen.geometry.conventions.opencv_from_colmap_pixels`.
 
 A view without a keypoint file has 0 keypoints and a pair without a match file has 0 matches: both
 are scored (as failures), and listed, never dropped. Every problem is an
@@ -86,7 +86,7 @@ def read_keypoints(path, pixel_origin: str = "center") -> np.ndarray:
             pts.append((x, y))
         xy = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     if pixel_origin == "corner":
-        from scenegen.conventions import opencv_from_colmap_pixels
+        from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
         xy = opencv_from_colmap_pixels(xy)
     return xy

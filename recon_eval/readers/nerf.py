@@ -2,7 +2,7 @@
 
 Each frame's ``transform_matrix`` is a 4x4 camera-to-world with OpenGL camera axes (+x right,
 +y up, +z backward); it is converted to OpenCV ``cam_from_world`` by the project's one conversion,
-:func:`scenegen.conventions.cam_from_world_from_opengl`. Frames are named by the stem of their
+:func:`scenegen.geometry.conventions.cam_from_world_from_opengl`. Frames are named by the stem of their
 ``file_path`` (``images/cam0_000.png`` -> ``cam0_000``; instant-ngp often omits the extension), so
 they match our datasets' view names and COLMAP image names without directories.
 
@@ -11,7 +11,7 @@ Intrinsics (top level, or per frame where nerfstudio allows it): ``fl_x``/``fl_y
 ``k1 k2 k3 k4 p1 p2`` and ``camera_model`` (``OPENCV`` default, ``OPENCV_FISHEYE``). NeRF codes
 cast rays through ``pixel + 0.5`` (COLMAP's pixel convention, and colmap2nerf copies COLMAP's
 cx, cy), so the principal point is moved to OpenCV pixels by
-:func:`scenegen.conventions.opencv_from_colmap_pixels` (``cx - 0.5``).
+:func:`scenegen.geometry.conventions.opencv_from_colmap_pixels` (``cx - 0.5``).
 
 nerfstudio records the transform it applied to the poses (``applied_transform``, 3x4, to the
 stored world from the original one); it is returned as read, not undone.
@@ -34,7 +34,7 @@ from recon_eval.readers._text import read_text
 @dataclass(frozen=True)
 class NerfTransforms:
     poses: Poses  # cam_from_world (OpenCV axes), named by file_path stem
-    cameras: dict  # name -> scenegen.camera.Camera (None when the file gives no intrinsics)
+    cameras: dict  # name -> scenegen.geometry.camera.Camera (None when the file gives no intrinsics)
     file_paths: tuple  # as written in the file, same order as poses
     applied_transform: np.ndarray | None  # (3, 4) nerfstudio applied_transform, or None
 
@@ -44,7 +44,7 @@ _INTRINSIC_KEYS = ("fl_x", "fl_y", "camera_angle_x", "camera_angle_y", "cx", "cy
 
 
 def _camera(fields: dict, where: str):
-    from scenegen.camera import Camera
+    from scenegen.geometry.camera import Camera
 
     if "w" not in fields or "h" not in fields:
         return None
@@ -62,7 +62,7 @@ def _camera(fields: dict, where: str):
             fy = 0.5 * h / math.tan(0.5 * float(fields["camera_angle_y"]))
         else:
             fy = fx
-        from scenegen.conventions import opencv_from_colmap_pixels
+        from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
         cx, cy = opencv_from_colmap_pixels([float(fields.get("cx", w / 2.0)), float(fields.get("cy", h / 2.0))])
         k = {n: float(fields.get(n, 0.0)) for n in ("k1", "k2", "k3", "k4", "p1", "p2")}
@@ -78,7 +78,7 @@ def _camera(fields: dict, where: str):
 
 
 def read_nerf_transforms(path) -> NerfTransforms:
-    from scenegen.conventions import cam_from_world_from_opengl
+    from scenegen.geometry.conventions import cam_from_world_from_opengl
 
     p = Path(path)
     if not p.is_file():
@@ -129,8 +129,8 @@ def write_nerf_transforms(path, poses: Poses, camera=None, *, extension: str = "
     """Write ``poses`` (cam_from_world) as transforms.json (OpenGL camera-to-world), file_path
     ``images/<name><extension>``; intrinsics of ``camera`` (scenegen Camera, pinhole/opencv) at
     top level with cx, cy in the NeRF (pixel + 0.5) convention. For tests and exports."""
-    from scenegen.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
-    from scenegen.pose import Rigid3
+    from scenegen.geometry.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
+    from scenegen.geometry.pose import Rigid3
 
     doc: dict = {}
     if camera is not None:

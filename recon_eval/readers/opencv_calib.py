@@ -1,4 +1,4 @@
-"""OpenCV calibration files (YAML or JSON, ``cv2.FileStorage``) -> :class:`scenegen.camera.Camera`.
+"""OpenCV calibration files (YAML or JSON, ``cv2.FileStorage``) -> :class:`scenegen.geometry.camera.Camera`.
 
 Accepted fields (the first present name wins):
 
@@ -54,13 +54,13 @@ def _first(fs, keys):
 
 
 def read_opencv_calibration(path, *, model: str | None = None, size: tuple | None = None):
-    """A :class:`scenegen.camera.Camera` from an OpenCV calibration YAML/JSON file.
+    """A :class:`scenegen.geometry.camera.Camera` from an OpenCV calibration YAML/JSON file.
 
     ``model``: ``"opencv"`` or ``"fisheye"`` overrides the file's ``distortion_model``;
     ``size`` (W, H) is used when the file gives no image size.
     """
     import cv2
-    from scenegen.camera import Camera
+    from scenegen.geometry.camera import Camera
 
     p = Path(path)
     if not p.is_file():

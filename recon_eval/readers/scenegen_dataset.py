@@ -5,7 +5,7 @@ metrics need is exposed in recon_eval's conventions:
 
 * poses: ``cam_from_world`` of every *complete* view from cameras.json, named by view name, in the
   run's view order (:class:`recon_eval.poses.Poses`);
-* cameras: :class:`scenegen.camera.Camera` per view (OpenCV pixels, model and distortion);
+* cameras: :class:`scenegen.geometry.camera.Camera` per view (OpenCV pixels, model and distortion);
 * depth: ``depth_z`` (H, W) float64 metres from ``truth/<view>.exr``, NaN where the pixel centre's
   ray hit nothing (the file stores +inf there; NaN is recon_eval's missing marker);
 * disparity of a rectified stereo pair: ``fx * baseline / depth_z`` for the left view (checked:
@@ -72,7 +72,7 @@ class DatasetTruth:
         return view
 
     def camera(self, view: str):
-        """(scenegen.camera.Camera, cam_from_world: scenegen.pose.Rigid3) of a view."""
+        """(scenegen.geometry.camera.Camera, cam_from_world: scenegen.geometry.pose.Rigid3) of a view."""
         self._check_view(view)
         try:
             return self._ds.camera(view)
@@ -93,7 +93,7 @@ class DatasetTruth:
     # --- per-pixel truth
     def _truth_channels(self, view: str) -> dict:
         self._check_view(view)
-        from scenegen import io as sio
+        from scenegen.dataset import codecs as sio
 
         path = self.root / "truth" / f"{view}.exr"
         if not path.is_file():

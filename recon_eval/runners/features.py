@@ -60,7 +60,7 @@ def _write_txt(path, rows, fmt: str, header: str) -> None:
     """np.savetxt, written atomically (a reader never sees half a file)."""
     import io
 
-    from scenegen.io import atomic_write_bytes
+    from scenegen.dataset.files import atomic_write_bytes
 
     buf = io.StringIO()
     np.savetxt(buf, rows, fmt=fmt, header=header)

@@ -15,6 +15,6 @@ One idea per module:
 * :mod:`.targets`: per-view calibration-board corner truth.
 * :mod:`.stage`: the pipeline stage that writes all of it into a dataset.
 
-Conventions are the project's (:mod:`scenegen.conventions`); the cross-view ones are documented in
+Conventions are the project's (:mod:`scenegen.geometry.conventions`); the cross-view ones are documented in
 ``docs/crossview.md``. Only :mod:`.raycast` and :mod:`.stage` import Mitsuba (lazily).
 """

@@ -6,47 +6,24 @@ OpenCV pixels (centre of the top-left pixel = (0, 0)). Its state:
 
 * ``NO_SURFACE`` (0): pixel i saw nothing (no P);
 * ``VISIBLE`` (1): P projects inside j's image and nothing lies between j's centre and P
-  (decided by a ray cast, tolerance :data:`scenegen.crossview.raycast.OCCLUSION_REL_TOL`);
+  (decided by a ray cast, tolerance :data:`scenegen.render.raycast.OCCLUSION_REL_TOL`);
 * ``OCCLUDED`` (2): inside j's image but another surface is hit first;
 * ``OUT_OF_FRAME`` (3): P projects outside [-0.5, W - 0.5] x [-0.5, H - 0.5], behind j, or beyond
   j's model's valid field of view.
 
-numpy only: the visibility test is a function passed in (:func:`scenegen.crossview.raycast.visible_from`
-bound to a scene in the pipeline).
+numpy only: the visibility test is a function passed in (:func:`scenegen.render.raycast.visible_from`
+bound to a scene in the pipeline). The states and the stored form are the dataset's
+(:mod:`scenegen.dataset.crossview`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-from scenegen.pose import Rigid3
-
-NO_SURFACE, VISIBLE, OCCLUDED, OUT_OF_FRAME = 0, 1, 2, 3
-STATE_NAMES = {NO_SURFACE: "no_surface", VISIBLE: "visible", OCCLUDED: "occluded", OUT_OF_FRAME: "out_of_frame"}
-
-
-@dataclass(frozen=True, eq=False)
-class Correspondence:
-    """Dense correspondence field of view i in view j, arrays over i's pixels (H_i, W_i)."""
-
-    uv: np.ndarray  # (H, W, 2) float64 pixels of j (NaN where there is no surface or no projection)
-    z: np.ndarray  # (H, W) float64 depth (z along j's optical axis) of P in j's frame, metres (NaN: none)
-    state: np.ndarray  # (H, W) uint8, NO_SURFACE / VISIBLE / OCCLUDED / OUT_OF_FRAME
-
-    @property
-    def visible(self) -> np.ndarray:
-        return self.state == VISIBLE
-
-
-def in_frame(uv, camera) -> np.ndarray:
-    """(N,) bool: pixel positions (N, 2) inside the image area [-0.5, W-0.5] x [-0.5, H-0.5]."""
-    uv = np.asarray(uv, float)
-    with np.errstate(invalid="ignore"):
-        return ((uv[:, 0] >= -0.5) & (uv[:, 0] <= camera.width - 0.5)
-                & (uv[:, 1] >= -0.5) & (uv[:, 1] <= camera.height - 0.5))
-
+from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIBLE, Correspondence
+from scenegen.geometry.conventions import in_image
+from scenegen.geometry.pose import Rigid3
 
 def project_points(points_world, camera, cam_from_world: Rigid3):
     """((N, 2) pixels, (N,) z in the camera frame, (N,) valid projection) of world points (N, 3)."""
@@ -69,24 +46,12 @@ def correspond(points_world_i, camera_j, cam_j_from_world: Rigid3,
     idx = np.flatnonzero(has)
     uv_h, z_h, valid = project_points(flat[idx], camera_j, cam_j_from_world)
     uv[idx], z[idx] = uv_h, z_h
-    inside = valid & in_frame(uv_h, camera_j)
+    inside = valid & in_image(uv_h, camera_j.width, camera_j.height)
     state[idx] = OUT_OF_FRAME
     cand = idx[inside]
     vis = np.asarray(visible_fn(cam_j_from_world.inverse().t, flat[cand]), bool)
     state[cand] = np.where(vis, VISIBLE, OCCLUDED)
     return Correspondence(uv.reshape(H, W, 2), z.reshape(H, W), state.reshape(H, W))
-
-
-def encode_correspondence(c: Correspondence) -> dict[str, np.ndarray]:
-    """EXR channels: ``u``, ``v`` (FLOAT, pixels of j), ``z`` (FLOAT, metres in j), ``state``
-    (UINT, 0..3)."""
-    return {"u": c.uv[..., 0].astype(np.float32), "v": c.uv[..., 1].astype(np.float32),
-            "z": c.z.astype(np.float32), "state": c.state.astype(np.uint32)}
-
-
-def decode_correspondence(channels) -> Correspondence:
-    uv = np.stack([channels["u"], channels["v"]], -1).astype(np.float64)
-    return Correspondence(uv, np.asarray(channels["z"], np.float64), np.asarray(channels["state"]).astype(np.uint8))
 
 
 def flow_field(c: Correspondence) -> np.ndarray:

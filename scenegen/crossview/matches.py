@@ -18,12 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-MATCH_COLUMNS = ("u_i", "v_i", "u_j", "v_j", "u_j_true", "v_j_true", "label", "error_px")
-INLIER, UNIFORM_OUTLIER, NEAR_MISS_OUTLIER, WRONG, NO_TRUTH = 0, 1, 2, 3, 4
-LABELS = {INLIER: "inlier", UNIFORM_OUTLIER: "uniform_outlier", NEAR_MISS_OUTLIER: "near_miss_outlier",
-          WRONG: "wrong (real match farther than the inlier threshold from the truth)",
-          NO_TRUTH: "no_truth (the point is not visible in j: occluded, out of frame or no surface)"}
-
+from scenegen.dataset.crossview import INLIER, MATCH_COLUMNS, NEAR_MISS_OUTLIER, NO_TRUTH, UNIFORM_OUTLIER, WRONG
+from scenegen.geometry.color import to_grey8
 
 @dataclass(frozen=True, kw_only=True)
 class MatchParams:
@@ -66,16 +62,6 @@ def synthetic_matches(uv_j, visible, width_j: int, height_j: int, p: MatchParams
     err = np.hypot(*(obs_j - xj_true).T)
     rows = np.column_stack([obs_i, obs_j, xj_true, label, err])
     return rows[rng.permutation(n)]
-
-
-def to_grey8(image) -> np.ndarray:
-    """uint8 grey of an (H, W[, 3]) uint8/uint16 RGB image (for feature detection)."""
-    import cv2
-
-    a = np.asarray(image)
-    if a.dtype == np.uint16:
-        a = (a.astype(np.float64) / 257.0 + 0.5).astype(np.uint8)
-    return cv2.cvtColor(a, cv2.COLOR_RGB2GRAY) if a.ndim == 3 else a
 
 
 def sift_matches(image_i, image_j, ratio: float = 0.8) -> tuple[np.ndarray, np.ndarray]:

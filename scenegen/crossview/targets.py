@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenegen.crossview.correspondence import OCCLUDED, OUT_OF_FRAME, VISIBLE, in_frame, project_points
+from scenegen.dataset.crossview import OCCLUDED, OUT_OF_FRAME, VISIBLE
+from scenegen.geometry.conventions import in_image
+from scenegen.crossview.correspondence import project_points
 
 
 def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn) -> dict:
@@ -30,7 +32,7 @@ def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn
 def _points_truth(points_board, world_from_board, camera, cam_from_world, visible_fn) -> dict:
     P = world_from_board.apply(points_board)
     uv, z, valid = project_points(P, camera, cam_from_world)
-    inside = valid & in_frame(uv, camera)
+    inside = valid & in_image(uv, camera.width, camera.height)
     C = cam_from_world.inverse().t
     n_print = world_from_board.rotate(np.array([0.0, 0.0, -1.0]))  # print side normal, world
     facing = (C - P) @ n_print > 0

@@ -1,6 +1,6 @@
 """Exports of a dataset folder into other tools' formats, one module per format.
 
-``export(out_dir, fmt, dest)`` reads a dataset (``scenegen.dataset.Dataset``; its cross-view
+``export(out_dir, fmt, dest)`` reads a dataset (:class:`scenegen.dataset.reader.Dataset`; its cross-view
 files where a format needs them) and writes ``dest`` (a new or empty folder). Nothing here
 imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 
@@ -14,15 +14,15 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 """
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 
-FORMATS = {"colmap": "colmap", "nerf": "nerf", "kitti-stereo": "kitti_stereo",
-           "middlebury": "middlebury", "opencv": "opencv_yaml", "tum": "tum"}
+from scenegen.export import colmap, kitti_stereo, middlebury, nerf, opencv_yaml, tum
+from scenegen.export.common import open_dataset, prepare_dest
+from scenegen.export.errors import ExportError
 
-
-class ExportError(ValueError):
-    """The dataset cannot be exported in the requested format (message says why)."""
+#: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
+FORMATS = {"colmap": colmap.export, "nerf": nerf.export, "kitti-stereo": kitti_stereo.export,
+           "middlebury": middlebury.export, "opencv": opencv_yaml.export, "tum": tum.export}
 
 
 def default_dest(out_dir, fmt: str) -> Path:
@@ -36,12 +36,9 @@ def export(out_dir, fmt: str, dest=None) -> dict:
     returns a summary dict ``{"dest": ..., "files": n, ...}``."""
     if fmt not in FORMATS:
         raise ExportError(f"unknown export format {fmt!r}; choose one of {', '.join(FORMATS)}")
-    from scenegen.export._common import open_dataset, prepare_dest
-
     ds = open_dataset(out_dir)
     dest = Path(dest) if dest is not None else default_dest(out_dir, fmt)
     prepare_dest(dest)
-    mod = importlib.import_module(f"scenegen.export.{FORMATS[fmt]}")
-    summary = mod.export(ds, dest)
+    summary = FORMATS[fmt](ds, dest)
     summary["dest"] = str(dest)
     return summary

@@ -1,7 +1,7 @@
 """COLMAP text model: cameras.txt, images.txt, points3D.txt (+ images/), tracks from truth.
 
 * One COLMAP camera per view (``Camera.to_colmap``: PINHOLE / OPENCV / FULL_OPENCV /
-  OPENCV_FISHEYE; COLMAP's principal point is OpenCV's + 0.5, see :mod:`scenegen.conventions`).
+  OPENCV_FISHEYE; COLMAP's principal point is OpenCV's + 0.5, see :mod:`scenegen.geometry.conventions`).
 * ``images.txt``: ``cam_from_world`` as (qw, qx, qy, qz, tx, ty, tz), image name = ``<view>.png``.
 * Tracks: for every cross-view correspondence file i -> j of the dataset, the pixels of i on a
   grid of stride ``STRIDE_PX`` that are VISIBLE in at least one j become 3D points (the truth
@@ -16,10 +16,11 @@ import shutil
 
 import numpy as np
 
-from scenegen import io as sio
-from scenegen.conventions import colmap_from_opencv_pixels, colmap_pose
-from scenegen.crossview.correspondence import VISIBLE
-from scenegen.export._common import crossview_index, fmt, write
+from scenegen.dataset.crossview import VISIBLE
+from scenegen.dataset.layout import view_paths
+from scenegen.export.common import crossview_index, fmt, write
+from scenegen.geometry.color import to_uint8
+from scenegen.geometry.conventions import colmap_from_opencv_pixels, colmap_pose
 
 STRIDE_PX = 8
 
@@ -37,22 +38,21 @@ def export(ds, dest) -> dict:
         cam_lines.append(f"{vid[v]} {model} {cam.width} {cam.height} " + " ".join(fmt(p) for p in params))
     # visible-in lists per reference view
     links: dict[str, list[str]] = {}
-    for p in index["pairs"]:
-        for i, j in ((p["i"], p["j"]), (p["j"], p["i"])):
+    for a, b in index.pairs:
+        for i, j in ((a, b), (b, a)):
             if i in vid and j in vid:
                 links.setdefault(i, []).append(j)
     obs: dict[str, list] = {v: [] for v in views}  # view -> [(u, v, point_id)]
     point_id = 0
     for i, others in links.items():
         truth = ds.truth(i)
-        image = ds.image(i)
+        image = to_uint8(ds.image(i))
         H, W = truth["valid"].shape
         gv, gu = np.meshgrid(np.arange(0, H, STRIDE_PX), np.arange(0, W, STRIDE_PX), indexing="ij")
         gv, gu = gv.ravel(), gu.ravel()
         vis = {}
         for j in others:
-            st = sio.read_exr(ds.path(f"crossview/corr/{i}/{j}.exr"))["state"]
-            vis[j] = st[gv, gu] == VISIBLE
+            vis[j] = ds.crossview.correspondence(i, j).state[gv, gu] == VISIBLE
         any_vis = np.any(np.stack(list(vis.values())), axis=0) & truth["valid"][gv, gu]
         for k in np.flatnonzero(any_vis):
             X = truth["points_world"][gv[k], gu[k]].astype(np.float64)
@@ -68,9 +68,7 @@ def export(ds, dest) -> dict:
             for view, uv in seen:
                 obs[view].append((colmap_from_opencv_pixels(uv), point_id))
                 track.append((vid[view], len(obs[view]) - 1))
-            rgb = np.asarray(image[gv[k], gu[k]])
-            rgb = (rgb if image.dtype == np.uint8 else rgb / 257.0).astype(float).round().astype(int)
-            rgb = np.broadcast_to(rgb, (3,))
+            rgb = np.broadcast_to(np.asarray(image[gv[k], gu[k]]).astype(int), (3,))
             pt_lines.append(f"{point_id} {fmt(X[0])} {fmt(X[1])} {fmt(X[2])} {rgb[0]} {rgb[1]} {rgb[2]} 0 "
                             + " ".join(f"{a} {b}" for a, b in track))
     for v in views:
@@ -78,7 +76,7 @@ def export(ds, dest) -> dict:
         img_lines.append(f"{vid[v]} " + " ".join(fmt(x) for x in (*q, *t)) + f" {vid[v]} {v}.png")
         img_lines.append(" ".join(f"{fmt(uv[0])} {fmt(uv[1])} {pid}" for uv, pid in obs[v]))
         (dest / "images").mkdir(exist_ok=True)
-        shutil.copyfile(ds.path(f"images/{v}.png"), dest / "images" / f"{v}.png")
+        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     head = "# written by scenegen export (truth; pixels in COLMAP's convention)\n"
     write(dest, "cameras.txt", (head + "# CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]\n" + "\n".join(cam_lines) + "\n").encode())
     write(dest, "images.txt", (head + "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n"

@@ -15,8 +15,10 @@ import shutil
 
 import numpy as np
 
-from scenegen import io as sio
-from scenegen.export._common import stereo_frames, to_uint8, write
+from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.layout import stereo_dir, stereo_path
+from scenegen.export.common import stereo_frames, write
+from scenegen.geometry.color import to_uint8
 
 
 def _row(M) -> str:
@@ -27,18 +29,19 @@ def export(ds, dest) -> dict:
     frames = stereo_frames(ds)
     out = []
     for k, fr in enumerate(frames):
-        base, tag = fr["dir"], f"{k:06d}"
+        tag = f"{k:06d}"
         for side, folder in (("left", "image_2"), ("right", "image_3")):
-            img = to_uint8(sio.read_png(ds.path(f"{base}/{side}.png")))
-            write(dest, f"training/{folder}/{tag}_10.png", sio.encode_png(img))
+            write(dest, f"training/{folder}/{tag}_10.png", encode_png(to_uint8(fr.image(side))))
         for kind in ("occ", "noc"):
             (dest / f"training/disp_{kind}_0").mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(ds.path(f"{base}/disp_left_{kind}.png"), dest / f"training/disp_{kind}_0/{tag}_10.png")
-        calib = sio.read_json(ds.path(f"{base}/calib.json"))
+            shutil.copyfile(ds.path(stereo_path(fr.left_view, f"disparity_{kind}", "left")),
+                            dest / f"training/disp_{kind}_0/{tag}_10.png")
+        calib = fr.calib
         W, H = calib["size"]
         lines = [f"S_rect_02: {W:.6e} {H:.6e}", f"R_rect_02: {_row(np.eye(3))}", f"P_rect_02: {_row(calib['P1'])}",
                  f"S_rect_03: {W:.6e} {H:.6e}", f"R_rect_03: {_row(np.eye(3))}", f"P_rect_03: {_row(calib['P2'])}"]
         write(dest, f"training/calib_cam_to_cam/{tag}.txt", ("\n".join(lines) + "\n").encode())
-        out.append({"index": tag, "stereo_dir": base, "left_view": fr["left_view"], "right_view": fr["right_view"]})
+        out.append({"index": tag, "stereo_dir": stereo_dir(fr.left_view), "left_view": fr.left_view,
+                    "right_view": fr.right_view})
     write(dest, "frames.json", (json.dumps(out, indent=2) + "\n").encode())
     return {"files": 6 * len(frames) + 1, "frames": len(frames)}

@@ -13,10 +13,10 @@ import shutil
 
 import numpy as np
 
-from scenegen import io as sio
-from scenegen.crossview.correspondence import VISIBLE
-from scenegen.crossview.disparity import decode_pfm
-from scenegen.export._common import stereo_frames, write
+from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.crossview import VISIBLE
+from scenegen.dataset.layout import stereo_path
+from scenegen.export.common import stereo_frames, write
 
 
 def _mat(K) -> str:
@@ -27,16 +27,16 @@ def _mat(K) -> str:
 def export(ds, dest) -> dict:
     frames = stereo_frames(ds)
     for fr in frames:
-        base, name = fr["dir"], fr["left_view"]
+        name = fr.left_view  # a checked view name
         (dest / name).mkdir(parents=True, exist_ok=True)
-        for src, dst in (("left.png", "im0.png"), ("right.png", "im1.png"),
-                         ("disp_left.pfm", "disp0.pfm"), ("disp_right.pfm", "disp1.pfm")):
-            shutil.copyfile(ds.path(f"{base}/{src}"), dest / name / dst)
-        calib = sio.read_json(ds.path(f"{base}/calib.json"))
-        d0 = decode_pfm(ds.path(f"{base}/disp_left.pfm").read_bytes())
-        state = sio.read_exr(ds.path(f"{base}/corr_left.exr"))["state"]
+        for key, side, dst in (("image", "left", "im0.png"), ("image", "right", "im1.png"),
+                               ("disparity_pfm", "left", "disp0.pfm"), ("disparity_pfm", "right", "disp1.pfm")):
+            shutil.copyfile(ds.path(stereo_path(name, key, side)), dest / name / dst)
+        calib = fr.calib
+        d0 = fr.disparity("left")
+        state = fr.correspondence("left").state
         mask = np.where(state == VISIBLE, 255, np.where(np.isfinite(d0), 128, 0)).astype(np.uint8)
-        write(dest, f"{name}/mask0nocc.png", sio.encode_png(mask))
+        write(dest, f"{name}/mask0nocc.png", encode_png(mask))
         fin = d0[np.isfinite(d0)]
         vmin, vmax = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 0.0)
         W, H = calib["size"]

@@ -1,7 +1,7 @@
 """instant-ngp / nerfstudio ``transforms.json`` (+ images/).
 
 * ``transform_matrix``: camera-to-world 4x4 with OpenGL camera axes (x right, y up, z backward),
-  from :func:`scenegen.conventions.opengl_cam_to_world` (the project's one conversion).
+  from :func:`scenegen.geometry.conventions.opengl_cam_to_world` (the project's one conversion).
 * Intrinsics per frame (``fl_x, fl_y, cx, cy, w, h`` and the distortion of ``camera_model``
   OPENCV or OPENCV_FISHEYE); when every view shares one camera they are also given at the top
   level (instant-ngp reads those). Principal point in COLMAP's pixel convention (top-left pixel
@@ -16,21 +16,23 @@ import shutil
 
 import numpy as np
 
-from scenegen.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
-from scenegen.export._common import _error, write
+from scenegen.dataset.layout import view_paths
+from scenegen.export.common import write
+from scenegen.export.errors import ExportError
+from scenegen.geometry.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
 
 
 def intrinsics(cam) -> dict:
     cx, cy = colmap_from_opencv_pixels([cam.cx, cam.cy])
     d = {"fl_x": cam.fx, "fl_y": cam.fy, "cx": float(cx), "cy": float(cy), "w": cam.width, "h": cam.height}
     if cam.skew != 0:
-        raise _error("NeRF transforms.json has no skew; a camera has skew != 0")
+        raise ExportError("NeRF transforms.json has no skew; a camera has skew != 0")
     c = cam.coefficients()
     if cam.model == "fisheye":
         d.update(camera_model="OPENCV_FISHEYE", **{k: c[k] for k in ("k1", "k2", "k3", "k4")})
     elif cam.model == "opencv":
         if any(c[k] for k in ("k5", "k6", "s1", "s2", "s3", "s4")):
-            raise _error("NeRF transforms.json supports k1..k4, p1, p2 only (OpenCV model)")
+            raise ExportError("NeRF transforms.json supports k1..k4, p1, p2 only (OpenCV model)")
         d.update(camera_model="OPENCV", **{k: c[k] for k in ("k1", "k2", "k3", "k4", "p1", "p2")})
     else:
         d.update(camera_model="OPENCV", k1=0.0, k2=0.0, p1=0.0, p2=0.0)
@@ -46,7 +48,7 @@ def export(ds, dest) -> dict:
         all_intr.append(json.dumps(intr, sort_keys=True))
         frames.append({"file_path": f"images/{v}.png", **intr,
                        "transform_matrix": opengl_cam_to_world(pose).tolist()})
-        shutil.copyfile(ds.path(f"images/{v}.png"), dest / "images" / f"{v}.png")
+        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     doc = {"applied_transform": np.eye(4)[:3].tolist(), "frames": frames}
     if len(set(all_intr)) == 1:
         doc.update(json.loads(all_intr[0]))

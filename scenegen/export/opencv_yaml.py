@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenegen import io as sio
-from scenegen.crossview.twoview import TwoView
-from scenegen.export._common import write
+import cv2
+import numpy as np
+
+from scenegen.dataset.cameras import camera_of
+from scenegen.export.common import write
+from scenegen.geometry.twoview import TwoView
 
 
 def _fs():
-    import cv2
-
     return cv2.FileStorage("out.yaml", cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_MEMORY | cv2.FILE_STORAGE_FORMAT_YAML)
 
 
@@ -30,8 +31,6 @@ def _F_opencv(F):
 
 
 def export(ds, dest) -> dict:
-    import cv2
-
     fs = _fs()
     fs.startWriteStruct("views", cv2.FILE_NODE_SEQ)
     for v in ds.views:
@@ -49,42 +48,37 @@ def export(ds, dest) -> dict:
     fs.endWriteStruct()
     write(dest, "cameras.yaml", fs.releaseAndGetString().encode())
     n = 1
-    index_p = ds.path("crossview/index.json")
-    if index_p.is_file():
-        index = sio.read_json(index_p)
-        for fr in index["stereo"]:
-            calib = sio.read_json(ds.path(f"{fr['dir']}/calib.json"))
-            from scenegen.camera import Camera
-            from scenegen.pose import Rigid3
-
-            cl, cr = Camera.from_dict(calib["raw_left"]["camera"]), Camera.from_dict(calib["raw_right"]["camera"])
-            pl, pr = Rigid3.from_dict(calib["raw_left"]["cam_from_world"]), Rigid3.from_dict(calib["raw_right"]["cam_from_world"])
-            tv = TwoView.of(cl, pl, cr, pr)
-            fs = _fs()
-            (K1, D1), (K2, D2) = cl.to_opencv(), cr.to_opencv()
-            for key, val in (("K1", K1), ("D1", D1.reshape(1, -1)), ("K2", K2), ("D2", D2.reshape(1, -1)),
-                             ("image_size", np.array([cl.width, cl.height], np.int32)),
-                             ("R", tv.j_from_i.R), ("T", tv.j_from_i.t.reshape(3, 1)), ("E", tv.E),
-                             ("F", _F_opencv(tv.F)), ("R1", np.array(calib["R1"])), ("R2", np.array(calib["R2"])),
-                             ("P1", np.array(calib["P1"])), ("P2", np.array(calib["P2"])), ("Q", np.array(calib["Q"]))):
-                fs.write(key, val)
-            write(dest, f"stereo/{fr['left_view']}.yaml", fs.releaseAndGetString().encode())
-            n += 1
-        if index["pairs"]:
-            fs = _fs()
-            fs.startWriteStruct("pairs", cv2.FILE_NODE_SEQ)
-            for p in index["pairs"]:
-                tv = sio.read_json(ds.path(f"crossview/twoview/{p['i']}/{p['j']}.json"))
-                fs.startWriteStruct("", cv2.FILE_NODE_MAP)
-                fs.write("i", p["i"])
-                fs.write("j", p["j"])
-                fs.write("R", np.array(tv["j_from_i"]["R"]))
-                fs.write("T", np.array(tv["j_from_i"]["t"]).reshape(3, 1))
-                if tv["E"] is not None:  # null for a zero baseline (no epipolar geometry)
-                    fs.write("E", np.array(tv["E"]))
-                    fs.write("F", _F_opencv(tv["F"]))
-                fs.endWriteStruct()
+    if ds.crossview.index is None:
+        return {"files": n}
+    for fr in ds.crossview.stereo_frames():
+        calib = fr.calib
+        (cl, pl), (cr, pr) = camera_of(calib["raw_left"]), camera_of(calib["raw_right"])
+        tv = TwoView.of(cl, pl, cr, pr)
+        fs = _fs()
+        (K1, D1), (K2, D2) = cl.to_opencv(), cr.to_opencv()
+        for key, val in (("K1", K1), ("D1", D1.reshape(1, -1)), ("K2", K2), ("D2", D2.reshape(1, -1)),
+                         ("image_size", np.array([cl.width, cl.height], np.int32)),
+                         ("R", tv.j_from_i.R), ("T", tv.j_from_i.t.reshape(3, 1)), ("E", tv.E),
+                         ("F", _F_opencv(tv.F)), ("R1", np.array(calib["R1"])), ("R2", np.array(calib["R2"])),
+                         ("P1", np.array(calib["P1"])), ("P2", np.array(calib["P2"])), ("Q", np.array(calib["Q"]))):
+            fs.write(key, val)
+        write(dest, f"stereo/{fr.left_view}.yaml", fs.releaseAndGetString().encode())
+        n += 1
+    if ds.crossview.pairs:
+        fs = _fs()
+        fs.startWriteStruct("pairs", cv2.FILE_NODE_SEQ)
+        for i, j in ds.crossview.pairs:
+            tv = ds.crossview.twoview(i, j)
+            fs.startWriteStruct("", cv2.FILE_NODE_MAP)
+            fs.write("i", i)
+            fs.write("j", j)
+            fs.write("R", tv.j_from_i.R)
+            fs.write("T", tv.j_from_i.t.reshape(3, 1))
+            if tv.E is not None:  # null for a zero baseline (no epipolar geometry)
+                fs.write("E", tv.E)
+                fs.write("F", _F_opencv(tv.F))
             fs.endWriteStruct()
-            write(dest, "pairs.yaml", fs.releaseAndGetString().encode())
-            n += 1
+        fs.endWriteStruct()
+        write(dest, "pairs.yaml", fs.releaseAndGetString().encode())
+        n += 1
     return {"files": n}

@@ -4,19 +4,19 @@ A stream is the views of one camera name, rig and rig member, in frame order; it
 ``<rig>_<member>.txt`` for a rig member and ``<camera>.txt`` for a free camera. Each line is the
 camera's pose in the world (world_from_cam: t = camera centre, q = its rotation, scalar LAST as
 TUM writes it), OpenCV camera axes, metres. Timestamp = frame_index (seconds; the dataset has no
-clock). Quaternions come from :func:`scenegen.conventions.quat_wxyz_from_matrix`.
+clock). Quaternions come from :func:`scenegen.geometry.rotation.quat_wxyz_from_matrix`.
 """
 from __future__ import annotations
 
-from scenegen.conventions import quat_wxyz_from_matrix
-from scenegen.export._common import fmt, write
+from scenegen.export.common import fmt, name, write
+from scenegen.geometry.rotation import quat_wxyz_from_matrix
 
 
 def export(ds, dest) -> dict:
     streams: dict[str, list] = {}
     for v in ds.views:
         info = ds.view_info(v)
-        key = f"{info['rig']}_{info['rig_member']}" if info.get("rig") else info["camera_name"]
+        key = name("stream", f"{info['rig']}_{info['rig_member']}" if info.get("rig") else info["camera_name"])
         streams.setdefault(key, []).append((info["frame_index"], v))
     for key, items in streams.items():
         lines = ["# scenegen truth: timestamp (= frame index) tx ty tz qx qy qz qw, world_from_cam, OpenCV camera axes"]

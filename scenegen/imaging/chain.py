@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from scenegen.geometry.color import quantise
 from scenegen.imaging import bayer, response, seeds
 from scenegen.imaging.exposure import ExposureParams, photons_per_radiance
 from scenegen.imaging.noise import SensorParams, expose_sensor
@@ -78,7 +79,7 @@ def apply_chain(linear_rgb: np.ndarray, params: ImagingParams, camera, seed: int
     """Run the chain on one clean linear render.
 
     linear_rgb: (H, W, 3) float radiance, W m^-2 sr^-1 (the render's linear RGB).
-    camera: :class:`scenegen.camera.Camera` of size (W, H) (for the cos^4 rays and the centre).
+    camera: :class:`scenegen.geometry.camera.Camera` of size (W, H) (for the cos^4 rays and the centre).
     seed: frame seed (:func:`scenegen.imaging.seeds.frame_seed` of scene seed and view index).
     """
     L = np.asarray(linear_rgb)
@@ -98,7 +99,7 @@ def apply_chain(linear_rgb: np.ndarray, params: ImagingParams, camera, seed: int
     x = response.normalise(dn, s.black_level_dn, s.white_level_dn)  # 7
     wb = params.white_balance if params.white_balance is not None else neutral_white_balance(params)
     x = response.white_balance(x, wb)  # 8
-    img = response.quantise(response.encode_response(x, params.response, params.gamma),  # 9, 10
+    img = quantise(response.encode_response(x, params.response, params.gamma),  # 9, 10
                             params.bit_depth)
     record = {
         "stages": list(STAGES),

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from scenegen.geometry.color import srgb_from_linear
+
 RESPONSES = ("srgb", "gamma", "linear")
-OUTPUT_BIT_DEPTHS = (8, 16)
 
 
 def normalise(dn: np.ndarray, black_level_dn: float, white_level_dn: float) -> np.ndarray:
@@ -24,27 +25,13 @@ def white_balance(x: np.ndarray, gains) -> np.ndarray:
     return np.clip(np.asarray(x, dtype=np.float64) * np.asarray(gains, dtype=np.float64), 0.0, 1.0)
 
 
-def srgb_oetf(x: np.ndarray) -> np.ndarray:
-    """sRGB encoding of linear values in [0, 1] (IEC 61966-2-1)."""
-    x = np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
-
-
 def encode_response(x: np.ndarray, response: str, gamma: float = 2.2) -> np.ndarray:
     """Linear [0, 1] -> encoded [0, 1] by the camera response curve."""
     x = np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)
     if response == "srgb":
-        return srgb_oetf(x)
+        return srgb_from_linear(x)
     if response == "gamma":
         return np.power(x, 1.0 / gamma)
     if response == "linear":
         return x
     raise ValueError(f"response must be one of {RESPONSES}, got {response!r}")
-
-
-def quantise(x: np.ndarray, bit_depth: int) -> np.ndarray:
-    """[0, 1] -> uint8 / uint16, rounding to nearest (values outside [0, 1] are clipped)."""
-    if bit_depth not in OUTPUT_BIT_DEPTHS:
-        raise ValueError(f"bit_depth must be one of {OUTPUT_BIT_DEPTHS}, got {bit_depth!r}")
-    top = (1 << bit_depth) - 1
-    return np.rint(np.clip(x, 0.0, 1.0) * top).astype(np.uint8 if bit_depth == 8 else np.uint16)

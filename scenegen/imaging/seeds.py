@@ -9,13 +9,14 @@ that names what it is for, so a draw never depends on how many numbers an earlie
   ``[fixed_pattern_seed, crc32(stage)]`` where the spec derives ``fixed_pattern_seed`` from the
   camera's name (:func:`fixed_pattern_seed_for`).
 
-crc32 is zlib's (stable across platforms and Python versions, unlike ``hash``).
+The rule is :mod:`scenegen.geometry.seeds`' (crc32 is zlib's: stable across platforms and
+Python versions, unlike ``hash``); this module names the parts.
 """
 from __future__ import annotations
 
-import zlib
-
 import numpy as np
+
+from scenegen.geometry import seeds
 
 #: Stage names of the temporal draws (part of the seed; renaming one changes the noise).
 STAGE_SHOT = "shot_noise"
@@ -28,15 +29,14 @@ STAGE_DSNU = "dsnu"
 
 def frame_seed(scene_seed: int, view_index: int) -> int:
     """Seed of one frame's temporal noise (0 .. 2**32 - 1), fixed by (scene seed, view index)."""
-    ss = np.random.SeedSequence([int(scene_seed), int(view_index), zlib.crc32(b"imaging")])
-    return int(ss.generate_state(1)[0])
+    return seeds.seed32(scene_seed, view_index, "imaging")
 
 
 def fixed_pattern_seed_for(camera_name: str) -> int:
     """Default fixed-pattern seed of a camera: crc32 of its name (0 .. 2**32 - 1)."""
-    return zlib.crc32(camera_name.encode("utf-8"))
+    return seeds.name_seed32(camera_name)
 
 
 def stage_rng(seed: int, stage: str) -> np.random.Generator:
     """The generator of one stage: ``default_rng(SeedSequence([seed, crc32(stage)]))``."""
-    return np.random.default_rng(np.random.SeedSequence([int(seed), zlib.crc32(stage.encode())]))
+    return seeds.rng(seed, stage)

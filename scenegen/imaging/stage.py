@@ -8,21 +8,17 @@ from typing import Any
 
 import numpy as np
 
+from scenegen.dataset.codecs.exr import encode_exr
+from scenegen.dataset.layout import VIGNETTING_CHANNEL, VIGNETTING_TEMPLATE, vignetting_path
 from scenegen.imaging import seeds
 from scenegen.imaging.chain import apply_chain, electrons_per_radiance, neutral_white_balance
-
-#: The truth file of a view's vignetting map, relative to the dataset root (one float32 channel).
-VIGNETTING_PATH = "truth/{view}_vignetting.exr"
-VIGNETTING_CHANNEL = "V"
 
 
 def apply_imaging(linear_rgb: np.ndarray, params, camera, scene_seed: int, view_index: int,
                   view: str) -> tuple[np.ndarray, dict[str, bytes]]:
     """One view's delivered image and its extra truth files ``{relative path: EXR bytes}``."""
-    from scenegen import io as sio
-
     result = apply_chain(linear_rgb, params, camera, seeds.frame_seed(scene_seed, view_index))
-    extra = {VIGNETTING_PATH.format(view=view): sio.encode_exr({VIGNETTING_CHANNEL: result.vignetting})}
+    extra = {vignetting_path(view): encode_exr({VIGNETTING_CHANNEL: result.vignetting})}
     return result.image, extra
 
 
@@ -43,7 +39,7 @@ def imaging_record(spec, views) -> dict[str, Any] | None:
             "system_gain_dn_per_e": p.sensor.system_gain(p.exposure.gain_db),
             "white_balance_used": list(p.white_balance if p.white_balance is not None
                                        else neutral_white_balance(p)),
-            "vignetting_file": VIGNETTING_PATH,
+            "vignetting_file": VIGNETTING_TEMPLATE,
         } for name, p in cams.items()},
         "view_frame_seeds": {v.name: seeds.frame_seed(spec.seed, i)
                              for i, v in enumerate(views) if v.camera in cams},

@@ -50,7 +50,7 @@ def cos4_map(camera) -> np.ndarray:
 
 
 def vignetting_map(camera, params: VignettingParams) -> np.ndarray:
-    """(H, W) float64 relative illumination V >= 0 for ``camera`` (a scenegen.camera.Camera)."""
+    """(H, W) float64 relative illumination V >= 0 for ``camera`` (a scenegen.geometry.camera.Camera)."""
     W, H = camera.width, camera.height
     out = np.ones((H, W), dtype=np.float64)
     if params.natural_cos4:

@@ -14,8 +14,9 @@ import re
 import sys
 import warnings
 
+from scenegen.spec.model import RENDER_VARIANTS as VARIANTS  # the spec's `variant:` values
+
 MIN_LLVM_MAJOR = 16
-VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 _SEARCH = (
     "/usr/lib/x86_64-linux-gnu/libLLVM.so.*", "/usr/lib/x86_64-linux-gnu/libLLVM-*.so*",
     "/usr/lib/aarch64-linux-gnu/libLLVM.so.*", "/usr/lib/aarch64-linux-gnu/libLLVM-*.so*",
@@ -43,7 +44,7 @@ def find_libllvm() -> str | None:
     return max(found)[1] if found else None
 
 
-def _configure_llvm() -> bool:
+def configure_llvm() -> bool:
     """Point Dr.Jit at a good libLLVM if it has not been imported yet. True if one is set."""
     current = os.environ.get("DRJIT_LIBLLVM_PATH")
     if current and (_llvm_major(current) or MIN_LLVM_MAJOR) >= MIN_LLVM_MAJOR and os.path.isfile(current):
@@ -59,7 +60,7 @@ def _configure_llvm() -> bool:
 
 def llvm_available() -> bool:
     """True if Dr.Jit's LLVM back end runs with a libLLVM >= 16."""
-    if not _configure_llvm():
+    if not configure_llvm():
         return False
     import drjit as dr
 
@@ -70,7 +71,7 @@ def llvm_available() -> bool:
 
 
 def cuda_available() -> bool:
-    _configure_llvm()
+    configure_llvm()
     import drjit as dr
 
     try:

@@ -1,6 +1,7 @@
-"""Our camera model as a Mitsuba sensor: the renderer's rays come from scenegen.camera's arithmetic.
+"""Our camera model as a Mitsuba sensor: the renderer's rays come from scenegen.geometry.camera's arithmetic.
 
-The sensor generates each ray by unprojecting the film sample through :func:`unproject_uv`
+The sensor generates each ray by unprojecting the film sample through
+:func:`scenegen.geometry.camera.unproject_uv` with Dr.Jit's operations
 (distortion, skew and fx != fy included; no post-warp resampling) and rotating it into the world
 with the OpenCV ``world_from_cam`` pose. Mitsuba's own camera frame (x left, y up) is never used.
 Camera parameters and the pose are opaque Dr.Jit scalars, so a new camera of the same model
@@ -14,15 +15,16 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-from scenegen.camera import OPENCV_COEFFS, Camera, unproject_uv
-from scenegen.conventions import opencv_pixel_from_film
-from scenegen.pose import Rigid3
+from scenegen.geometry.camera import ALL_COEFFS, Camera, unproject_uv
+from scenegen.geometry.conventions import opencv_pixel_from_film
+from scenegen.geometry.pose import Rigid3
+from scenegen.render.drjit_ops import DRJIT_OPS
 
 SENSOR_PLUGIN = "scenegen_camera"
 
 
 class ScenegenSensor(mi.Sensor):
-    """Mitsuba sensor implementing a :class:`scenegen.camera.Camera` exactly.
+    """Mitsuba sensor implementing a :class:`scenegen.geometry.camera.Camera` exactly.
 
     Properties: ``film`` and ``sampler`` as for any sensor. The camera is set with
     :meth:`set_camera` (the builder does it right after loading).
@@ -46,8 +48,8 @@ class ScenegenSensor(mi.Sensor):
                    time_window=(0.0, 1.0)) -> None:
         """Use ``camera`` at pose ``cam_from_world`` (the mid-exposure pose).
 
-        ``optics`` (:class:`scenegen.optics.Optics`) adds a thin lens and a shutter; ``motion``
-        (:class:`scenegen.optics.Motion`, camera-frame velocities) moves the camera over the
+        ``optics`` (:class:`scenegen.geometry.optics.Optics`) adds a thin lens and a shutter; ``motion``
+        (:class:`scenegen.geometry.optics.Motion`, camera-frame velocities) moves the camera over the
         exposure. ``time_window`` is the part of the exposure this render covers (sub-frames).
         The film must already have the camera's size.
         """
@@ -56,7 +58,7 @@ class ScenegenSensor(mi.Sensor):
             raise ValueError(f"film is {film_size[0]}x{film_size[1]} but the camera is {camera.width}x{camera.height}")
         opaque = lambda x: dr.opaque(mi.Float, float(x))
         p = camera.params()
-        fields = ("fx", "fy", "cx", "cy", "skew") + OPENCV_COEFFS
+        fields = ("fx", "fy", "cx", "cy", "skew") + ALL_COEFFS
         self.p = SimpleNamespace(**{k: opaque(getattr(p, k)) for k in fields})
         self.model = camera.model
         self.iterations = camera.undistort_iterations
@@ -91,7 +93,7 @@ class ScenegenSensor(mi.Sensor):
         size = self.film().crop_size()
         offset = self.film().crop_offset()
         u, v = opencv_pixel_from_film(sample2, size, offset)
-        dx, dy, dz = unproject_uv(u, v, self.p, self.model, self.iterations)
+        dx, dy, dz = unproject_uv(u, v, self.p, self.model, self.iterations, DRJIT_OPS)
         o = mi.Vector3f(0.0)
         d = mi.Vector3f(dx, dy, dz)
         if self.lens is not None:
@@ -131,14 +133,9 @@ class ScenegenSensor(mi.Sensor):
         return f"ScenegenSensor[model={self.model}]"
 
 
-_registered = False
-
-
 def register() -> None:
-    """Register the sensor plugin with the current Mitsuba variant (idempotent per variant)."""
-    global _registered
+    """Register the sensor plugin with the current Mitsuba variant (registering again replaces it)."""
     mi.register_sensor(SENSOR_PLUGIN, lambda props: ScenegenSensor(props))
-    _registered = True
 
 
 def sensor_dict(camera: Camera, *, spp: int, sampler: str = "ldsampler", seed: int = 0,

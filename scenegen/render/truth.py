@@ -2,7 +2,7 @@
 
 Not Mitsuba's ``aov`` integrator: its depth is neither z-depth nor range and it is filtered by
 the reconstruction filter. Here each pixel centre (u, v) = (column, row) in OpenCV's convention
-is unprojected in float64 by :class:`scenegen.camera.Camera` (the same arithmetic as the
+is unprojected in float64 by :class:`scenegen.geometry.camera.Camera` (the same arithmetic as the
 renderer's sensor), rotated into the world, intersected with the scene in float32 by Mitsuba,
 and every output is derived in float64 in ONE Dr.Jit kernel (range and depth_z are returned in
 float64; points, normals and uv are rounded once to float32, the precision they are stored in):
@@ -26,9 +26,9 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-from scenegen.camera import Camera
-from scenegen.conventions import pixel_centers
-from scenegen.pose import Rigid3
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.conventions import pixel_centers
+from scenegen.geometry.pose import Rigid3
 
 
 @functools.lru_cache(maxsize=16)

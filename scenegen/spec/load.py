@@ -8,14 +8,15 @@ reported at validation time too.
 from __future__ import annotations
 
 import math
-import zlib
 from pathlib import Path
 
 import numpy as np
 
-from scenegen.conventions import matrix_from_quat_wxyz
+from scenegen.geometry.rotation import matrix_from_quat_wxyz
 from scenegen.errors import SpecError
-from scenegen.pose import Rigid3, look_at, rotation_from_euler_deg
+from scenegen.geometry import seeds
+from scenegen.geometry.pose import Rigid3, look_at
+from scenegen.geometry.rotation import rotation_from_euler_deg
 from scenegen.spec import model as m
 from scenegen.spec._yaml import Document, Fields, Node, suggest
 
@@ -47,8 +48,7 @@ def parse_spec(text: str, file: str = "<string>", base_dir=None) -> m.SceneSpec:
 
 def derive_seed(scene_seed: int, field_path: str) -> int:
     """Default seed of a seeded thing: stable, differs between field paths (0 .. 2**32 - 1)."""
-    ss = np.random.SeedSequence([scene_seed, zlib.crc32(field_path.encode())])
-    return int(ss.generate_state(1)[0])
+    return seeds.seed32(scene_seed, field_path)
 
 
 class _Parser:
@@ -533,7 +533,7 @@ class _Parser:
                     raise f.get(bad).error(f"give either fov_deg or fx and fy, not both")
             fov = f.float("fov_deg", unit="horizontal field of view, degrees", lo=0.0,
                           lo_open=True, hi=180.0, hi_open=True)
-            # As scenegen.camera.Camera.from_fov: the FoV of the undistorted pinhole.
+            # As scenegen.geometry.camera.Camera.from_fov: the FoV of the undistorted pinhole.
             fx = fy = (W / 2) / math.tan(math.radians(fov) / 2)
         else:
             if "fx" not in f:
@@ -769,7 +769,7 @@ class _Parser:
     # -- lens and time effects (scenegen/optics.py, docs/image_formation.md) -------------------
     def optics(self, f, model: str):
         """``lens``, ``shutter`` and ``chromatic_aberration`` of a camera, or None."""
-        from scenegen import optics as o
+        from scenegen.geometry import optics as o
 
         if not any(k in f for k in ("lens", "shutter", "chromatic_aberration")):
             return None
@@ -799,7 +799,7 @@ class _Parser:
 
     def motion(self, node: Node):
         """Constant linear (m/s) and angular (deg/s, rotation vector) velocities."""
-        from scenegen.optics import Motion
+        from scenegen.geometry.optics import Motion
 
         f = node.as_mapping("a motion (linear_velocity_mps, angular_velocity_deg_s)").check(
             optional=("linear_velocity_mps", "angular_velocity_deg_s"))
@@ -937,23 +937,23 @@ def _freeze(value):
 
 
 def _check_texture_params(kind: str, params: Fields):
-    """Parameter names against scenegen.textures (when present); values are its business."""
+    """Parameter names against scenegen.assets.textures (when present); values are its business."""
     try:
-        from scenegen.textures import texture_params
+        from scenegen.assets.textures import texture_params
     except ModuleNotFoundError as e:
-        if e.name == "scenegen.textures":
+        if e.name == "scenegen.assets.textures":
             return
         raise
     params.check(optional=texture_params(kind))
 
 
 def _check_with_camera_model(cam: m.CameraSpec, node: Node):
-    """Ask scenegen.camera (when present) whether the camera can exist (e.g. a distortion that
+    """Ask scenegen.geometry.camera (when present) whether the camera can exist (e.g. a distortion that
     folds over inside the image); its ValueError becomes a SpecError at the camera."""
     try:
-        import scenegen.camera  # noqa: F401
+        import scenegen.geometry.camera  # noqa: F401
     except ModuleNotFoundError as e:
-        if e.name == "scenegen.camera":
+        if e.name == "scenegen.geometry.camera":
             return
         raise
     try:

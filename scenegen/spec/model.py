@@ -1,9 +1,9 @@
 """The scene spec as frozen dataclasses: what :func:`scenegen.spec.load_spec` returns.
 
-Conventions (see :mod:`scenegen.conventions`): the world is right-handed and Z-up, in metres;
+Conventions (see :mod:`scenegen.geometry.conventions`): the world is right-handed and Z-up, in metres;
 camera axes are OpenCV's (+x right, +y down, +z forward); pixel (0, 0) is the CENTRE of the
 top-left pixel. Angles are degrees only in fields named ``*_deg`` (as written by the user);
-resolved rotations are matrices inside :class:`~scenegen.pose.Rigid3`. Quaternions are (w, x, y, z).
+resolved rotations are matrices inside :class:`~scenegen.geometry.pose.Rigid3`. Quaternions are (w, x, y, z).
 
 Every record that came from the YAML keeps ``where`` (file, line, field path) so that later
 stages can report a problem at its source with :meth:`scenegen.errors.SpecError.at`.
@@ -24,7 +24,7 @@ from typing import Any, Mapping, Union
 import numpy as np
 
 from scenegen.errors import Where
-from scenegen.pose import Rigid3
+from scenegen.geometry.pose import Rigid3
 
 _WHERE = dict(default=None, compare=False, repr=False)
 
@@ -119,7 +119,7 @@ class Texture:
     path: Path | None = None  # image file (absolute) for kind 'image'; None for procedural
     path_as_written: str | None = None  # the path as in the spec (relative to the spec file)
     params: Mapping[str, Any] = field(default_factory=frozen_mapping)  # procedural parameters,
-    # passed unchanged to scenegen.textures.make_texture(kind, params, seed); empty for 'image'
+    # passed unchanged to scenegen.assets.textures.make_texture(kind, params, seed); empty for 'image'
     seed: int = 0  # procedural seed (explicit, or derived from the scene seed and field path)
     where: Where | None = field(**_WHERE)
 
@@ -277,7 +277,7 @@ class SceneObject:
     material: Material  # resolved: the named material from `materials:` or an inline one
     object_id: int  # 1-based position in `objects:` (0 is the background in id images)
     instance_id: int  # as given, default = object_id (>= 1; may be shared between objects)
-    motion: Any = None  # scenegen.optics.Motion in the world, about the object origin; None = static
+    motion: Any = None  # scenegen.geometry.optics.Motion in the world, about the object origin; None = static
     where: Where | None = field(**_WHERE)
 
 
@@ -361,7 +361,7 @@ class CameraSpec:
     dist: tuple[float, ...] = ()  # distortion coefficients (unitless), see above
     fov_deg: float | None = None  # horizontal FoV of the undistorted pinhole as written (fx, fy
     # derived from it: fx = fy = (W/2) / tan(fov/2)), degrees
-    optics: Any = None  # scenegen.optics.Optics: thin lens, shutter (motion blur, rolling
+    optics: Any = None  # scenegen.geometry.optics.Optics: thin lens, shutter (motion blur, rolling
     # shutter), chromatic aberration; None = a pinhole with an instantaneous global shutter
     imaging: Any = None  # scenegen.imaging.ImagingParams: the photometric chain (exposure,
     # vignetting, EMVA 1288 sensor, Bayer, response; docs/image_formation.md); None = the clean
@@ -379,8 +379,8 @@ class CameraSpec:
         return np.array([[self.fx, self.skew, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
     def to_camera(self):
-        """The :class:`scenegen.camera.Camera` for these intrinsics (imported on use)."""
-        from scenegen.camera import Camera
+        """The :class:`scenegen.geometry.camera.Camera` for these intrinsics (imported on use)."""
+        from scenegen.geometry.camera import Camera
 
         return Camera(model=self.model, width=self.width, height=self.height, fx=self.fx,
                       fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew, dist=self.dist)
@@ -482,7 +482,7 @@ class ViewSet:
     camera: str | None  # a key of `cameras:` (exactly one of camera / rig)
     rig: str | None  # a key of `rigs:`
     placement: Placement  # where the camera (or the rig frame) goes
-    motion: Any = None  # scenegen.optics.Motion of the placed camera / rig frame (body velocities)
+    motion: Any = None  # scenegen.geometry.optics.Motion of the placed camera / rig frame (body velocities)
     lights: Mapping[str, float] | None = None  # illumination of this view set: every spec light
     # (spec order) -> factor (>= 0) on its spec power, 0 = off; None = every light at its power
     where: Where | None = field(**_WHERE)
@@ -503,7 +503,7 @@ class View:
     rig_member: str | None = None  # member name in the rig ('left', 'right', ...)
     frame_index: int = 0  # placement counter over all view sets; a rig's members share it
     view_set: int = 0  # index of the view set in `views:`
-    motion: Any = None  # scenegen.optics.Motion of this camera, in its own frame; None = static
+    motion: Any = None  # scenegen.geometry.optics.Motion of this camera, in its own frame; None = static
     light_scales: tuple[float, ...] | None = None  # factor on each spec light's power (spec
     # order; 0 = off) from the view set's `lights:`; None = every light at its spec power
 
@@ -562,4 +562,4 @@ class SceneSpec:
     variation: Any = None  # scenegen.spec.variation.VariationSpec: seeded ranges for
     # `scenegen render --variants N`; None = no variation declared
     variant: Mapping[str, Any] | None = None  # a derived variant's index, seed and drawn values
-    # (scenegen.variation.derive_variant); None for the spec as written
+    # (scenegen.spec.variants.derive_variant); None for the spec as written

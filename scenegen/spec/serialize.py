@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 from types import MappingProxyType
 
-from scenegen.pose import Rigid3
+from scenegen.geometry.pose import Rigid3
 from scenegen.spec import model as m
 from scenegen.spec.views import resolve_views
 

@@ -1,6 +1,6 @@
 """The optional top-level ``variation:`` section: seeded ranges that make scene variants.
 
-What is declared here is only ranges; :func:`scenegen.variation.derive_variant` draws one
+What is declared here is only ranges; :func:`scenegen.spec.variants.derive_variant` draws one
 variant's values from ``(spec, seed, index)``. Every range is validated at load time against
 the objects, lights and cameras it names, so that a bad range fails with file, line and field
 before anything renders. Nothing here imports Mitsuba. Documented in ``docs/scene_spec.md``.

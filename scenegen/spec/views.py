@@ -2,7 +2,7 @@
 
 Each placement yields ``world_from_X`` poses, X being the camera or, for a rig view set, the rig
 frame; a rig's member cameras are then ``world_from_cam = world_from_rig @ rig_from_cam``.
-Placements look at their targets with :func:`scenegen.pose.look_at` (OpenCV axes, world up +z by
+Placements look at their targets with :func:`scenegen.geometry.pose.look_at` (OpenCV axes, world up +z by
 default).
 
 Naming: every placement (one camera pose, or one rig pose shared by its members) gets the next
@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from scenegen.errors import SpecError
-from scenegen.pose import Rigid3, look_at
+from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
 
 #: Random eyes closer than this to the target, or looking (nearly) along up, are redrawn.
@@ -157,7 +157,7 @@ def _member_motion(rig_motion, rig_from_cam: Rigid3):
     v_cam = R^T (v + omega x t), with rig_from_cam = (R, t)."""
     if rig_motion is None:
         return None
-    from scenegen.optics import Motion
+    from scenegen.geometry.optics import Motion
 
     R, t = rig_from_cam.R, rig_from_cam.t
     w = np.radians(np.asarray(rig_motion.angular_velocity_deg_s, dtype=np.float64))

@@ -16,8 +16,8 @@ import numpy as np
 import trimesh
 
 from scenegen import dataset as ds
-from scenegen.camera import Camera
-from scenegen.pose import Rigid3, look_at
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.pose import Rigid3, look_at
 
 W, H = 40, 30
 BASELINE_M = 0.5

@@ -98,7 +98,7 @@ def _held_out(root, view, n=5000):
 
 # --- dlt: K and pose files, projective frame --------------------------------------------------
 def _synthetic(rng, n=60):
-    from scenegen.camera import Camera
+    from scenegen.geometry.camera import Camera
 
     cam = Camera("pinhole", 640, 480, 610.0, 590.0, 321.5, 238.25, 1.5)
     R, t = look_at_cam_from_world([4.0, -3.0, 2.0], target=[0.1, 0.2, 0.0])

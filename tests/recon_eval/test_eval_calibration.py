@@ -6,7 +6,7 @@ from recon_eval.calibration import intrinsics_errors, projection_difference, rep
 from recon_eval.errors import InputError
 from recon_eval.pnp import pnp_errors
 
-from scenegen.camera import Camera  # numpy-only at import (no Mitsuba)
+from scenegen.geometry.camera import Camera  # numpy-only at import (no Mitsuba)
 
 K = np.array([[500.0, 0.0, 319.5], [0.0, 505.0, 239.5], [0.0, 0.0, 1.0]])
 SIZE = (640, 480)

@@ -55,7 +55,7 @@ class TestPosesAgainstDataset:
         assert r["results"]["ape"]["trans_stats_m"]["max"] < 1e-12
 
     def test_colmap_model_matched_by_view_name(self, plane_dataset, tmp_path, capsys):
-        from scenegen.conventions import quat_wxyz_from_matrix
+        from scenegen.geometry.rotation import quat_wxyz_from_matrix
 
         root, _ = plane_dataset
         P = dataset_poses(root)
@@ -167,7 +167,7 @@ class TestFmatrixAgainstDataset:
 
 class TestCalibration:
     def test_against_dataset_and_file(self, plane_dataset, tmp_path, capsys):
-        from scenegen.camera import Camera
+        from scenegen.geometry.camera import Camera
 
         from recon_eval.readers.opencv_calib import write_opencv_calibration
 

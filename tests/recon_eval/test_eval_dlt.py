@@ -11,7 +11,7 @@ from recon_eval.dlt import (
     score_projection_projective,
 )
 from recon_eval.errors import InputError
-from scenegen.camera import Camera
+from scenegen.geometry.camera import Camera
 
 # RQ of an exactly built P is backward stable: float64 rounding (1e-16) times the condition of
 # K (fx / 1 ~ 1e3) and of the scale leaves ~1e-13; 1e-9 relative is the requirement.

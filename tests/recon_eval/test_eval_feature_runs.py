@@ -106,7 +106,7 @@ def _render(root: str):
     import time
     from pathlib import Path
 
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     spec = Path(root) / "features_test.yaml"
     spec.write_text(_spec())

@@ -137,7 +137,7 @@ def test_matching_score():
 
 
 def test_read_correspondence_map(tmp_path):
-    from scenegen import io as sio
+    from scenegen.dataset import codecs as sio
 
     cm, _ = homography_maps()
     sio.write_exr(tmp_path / "c.exr", {"u": cm.uv[..., 0].astype(np.float32), "v": cm.uv[..., 1].astype(np.float32),

@@ -160,7 +160,7 @@ class TestExr:
         np.testing.assert_array_equal(read_exr_map(tmp_path / "d.exr"), a)
 
     def test_channel_choice(self, tmp_path):
-        from scenegen.io import write_exr
+        from scenegen.dataset.codecs import write_exr
 
         from recon_eval.readers.exr import read_exr_map
 
@@ -188,7 +188,7 @@ class TestOpencvCalibration:
     @pytest.mark.parametrize("ext", [".yaml", ".json"])
     @pytest.mark.parametrize("cam", [PINHOLE, DISTORTED, "fisheye"])
     def test_round_trip(self, tmp_path, ext, cam):
-        from scenegen.camera import Camera
+        from scenegen.geometry.camera import Camera
 
         from recon_eval.readers.opencv_calib import read_opencv_calibration, write_opencv_calibration
 

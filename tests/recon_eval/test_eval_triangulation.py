@@ -12,7 +12,7 @@ from recon_eval.triangulation import (
     triangulate_opencv,
     triangulation_angle_deg,
 )
-from scenegen.camera import Camera
+from scenegen.geometry.camera import Camera
 
 # cv2.triangulatePoints solves the unnormalised 4x4 DLT in float64: pixel coordinates ~1e2-1e3 and
 # metres ~1 condition it to ~1e4, so noise-free points come back to ~1e-12 relative; 1e-9 relative

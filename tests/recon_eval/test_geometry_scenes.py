@@ -60,7 +60,7 @@ PROJECTIVE_TOL = 1e-7
 
 @pytest.fixture(scope="session")
 def scenes(tmp_path_factory):
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     root = tmp_path_factory.mktemp("geometry_scenes")
     render_spec(SCENES / "dlt_calibration_object.yaml", root / "dlt", progress=False)
@@ -137,7 +137,7 @@ def test_detected_corners_match_the_per_view_corner_truth(scenes):
 def test_rendered_marker_outlines_sit_on_the_corner_truth(scenes):
     from scipy.ndimage import map_coordinates
 
-    from scenegen import io as sio
+    from scenegen.dataset import codecs as sio
 
     root = scenes["dlt"]
     offsets = []
@@ -272,7 +272,7 @@ def test_zero_baseline_pairs_are_not_triangulated(tmp_path, capsys):
     from the index (and listed), and naming it is an error; the runner notes it."""
     from _recon_eval_helpers import ZERO_BASELINE_SPEC
     from recon_eval.runners import run_method
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     (tmp_path / "zb.yaml").write_text(ZERO_BASELINE_SPEC)
     render_spec(tmp_path / "zb.yaml", tmp_path / "ds", progress=False)

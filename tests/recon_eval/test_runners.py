@@ -22,7 +22,7 @@ SPP = {"calib_checkerboard": 16, "calib_checkerboard_noisy": 4, "stereo_tabletop
 
 @pytest.fixture(scope="session")
 def datasets(tmp_path_factory):
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     root = tmp_path_factory.mktemp("library")
     out = {}

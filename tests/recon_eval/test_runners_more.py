@@ -46,7 +46,7 @@ RANSAC_POINTS_TRANS_M = 0.005
 
 @pytest.fixture(scope="session")
 def more_datasets(tmp_path_factory):
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
 
     root = tmp_path_factory.mktemp("library_more")
     out = {}
@@ -139,7 +139,7 @@ def test_pnp_raw_output_lists_every_view(more_results):
 def test_f_and_e_runners_skip_zero_baseline_pairs(tmp_path):
     """The rolled view shares the reference's centre: its twoview truth has no F or E
     (crossview.md), so the F and E runners skip it with a note and score the other pair."""
-    from scenegen.pipeline import render_spec
+    from scenegen.pipeline.run import render_spec
     from recon_eval.runners import run_method
     from recon_eval.runners.twoview import ZERO_BASELINE_NOTE
 

@@ -1,0 +1,28 @@
+"""The dataset: the contract between the generator and the evaluator, and the only place that
+knows paths (docs/dataset_format.md, docs/crossview.md).
+
+* :mod:`.layout`: every relative path, and the checks on names that become paths;
+* :mod:`.codecs`: the file formats, encode and decode together (JSON, PNG, EXR, NPY, PFM, KITTI
+  PNG16, FLO, PLY);
+* :mod:`.files`: atomic writes and SHA-256;
+* :mod:`.manifest`, :mod:`.cameras`, :mod:`.truth`, :mod:`.crossview`: what each file holds;
+* :mod:`.writer`: :class:`DatasetWriter` (atomic, hashed, resumable);
+* :mod:`.reader` and :mod:`.crossview_reader`: :class:`Dataset`, typed access to everything;
+* :mod:`.verify`: re-hash a folder against its manifest.
+
+Nothing here imports Mitsuba or Dr.Jit.
+"""
+from scenegen.dataset.cameras import ViewCamera
+from scenegen.dataset.errors import DatasetError, DatasetMismatchError
+from scenegen.dataset.layout import CAMERAS, MANIFEST, mesh_path, view_paths
+from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION
+from scenegen.dataset.reader import Dataset
+from scenegen.dataset.truth import TRUTH_KEYS, check_truth
+from scenegen.dataset.verify import VerifyReport, verify
+from scenegen.dataset.writer import DatasetWriter, encode_view, software_versions, write_view_files
+
+__all__ = [
+    "CAMERAS", "MANIFEST", "FORMAT", "FORMAT_VERSION", "TRUTH_KEYS", "DatasetError", "DatasetMismatchError",
+    "ViewCamera", "view_paths", "mesh_path", "check_truth", "encode_view", "write_view_files",
+    "software_versions", "DatasetWriter", "Dataset", "VerifyReport", "verify",
+]

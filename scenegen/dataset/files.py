@@ -1,0 +1,99 @@
+"""Atomic, durable writes and content hashes: how every file of a dataset (and every report of
+the evaluator) reaches the disk.
+
+A write first has the whole content in memory, then goes to a temporary file in the destination
+directory, is ``fsync``'ed, renamed over the final name (``os.replace``) and the directory is
+``fsync``'ed. A reader sees either the old file or the complete new one, never a partial file,
+even if the process is killed (SIGKILL) or the machine loses power mid-write. A killed write can
+leave a temporary file named ``.<name>.<random>.scenegen-tmp`` beside the target
+(:func:`remove_stale_temp_files`).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import secrets
+from pathlib import Path
+from typing import BinaryIO, Callable
+
+#: Suffix of the temporary files made by :func:`atomic_write` (``.<name>.<random>.scenegen-tmp``).
+TEMP_SUFFIX = ".scenegen-tmp"
+
+_HASH_CHUNK = 1 << 20  # bytes read at a time by sha256_file
+
+
+# --- atomic writes ----------------------------------------------------------------------------
+def _fsync_dir(directory: Path) -> None:
+    """Make a rename in ``directory`` durable (no-op where directories cannot be opened)."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:  # e.g. Windows
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def atomic_write(path, write_fn: Callable[[BinaryIO], None]) -> None:
+    """Write ``path`` atomically by calling ``write_fn(f)`` on a temporary binary file.
+
+    The temporary file is in the same directory as ``path`` (created with its parents if needed),
+    is flushed and fsync'ed, then renamed over ``path``. If ``write_fn`` raises, the temporary file
+    is removed, ``path`` is left exactly as it was (old content or absent) and the error propagates.
+    New files get the usual permissions (0o666 minus the umask).
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}{TEMP_SUFFIX}"
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write_fn(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    _fsync_dir(path.parent)
+
+
+def atomic_write_bytes(path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_write`)."""
+    data = bytes(data) if not isinstance(data, bytes) else data
+    atomic_write(path, lambda f: f.write(data))
+
+
+def remove_stale_temp_files(root) -> list[Path]:
+    """Delete temporary files left under ``root`` by killed :func:`atomic_write` calls.
+
+    Only files named ``.<name>.<random>.scenegen-tmp`` are touched. Call it only when no writer is
+    running on ``root``. Returns the removed paths.
+    """
+    removed = []
+    for p in sorted(Path(root).rglob(f".*{TEMP_SUFFIX}")):
+        if p.is_file():
+            p.unlink()
+            removed.append(p)
+    return removed
+
+
+# --- hashes -----------------------------------------------------------------------------------
+def sha256_bytes(data: bytes) -> str:
+    """Lower-case hex SHA-256 of ``data``."""
+    return hashlib.sha256(data).hexdigest()
+
+
+def sha256_file(path) -> str:
+    """Lower-case hex SHA-256 of the file's bytes (read in 1 MiB chunks)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        while chunk := f.read(_HASH_CHUNK):
+            h.update(chunk)
+    return h.hexdigest()

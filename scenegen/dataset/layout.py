@@ -1,0 +1,165 @@
+"""Where every file of a dataset lives: the only module that spells out the layout.
+
+All paths are relative POSIX paths inside the dataset folder (documented for readers outside
+this project in docs/dataset_format.md and docs/crossview.md)::
+
+    manifest.json                           format, spec hash, seed, variant, versions, status, hashes
+    cameras.json                            per view: camera, cam_from_world, rig, optics, lights; the spec
+    scene/meshes/<object>.ply               world-frame meshes
+    scene/targets/<object>.json             calibration-target points (board and world frame)
+    images/<view>.png                       rendered image, uint8 or uint16, RGB or grey
+    images/<view>_linear.exr                clean linear float32 RGB (R, G, B)
+    truth/<view>.exr                        float32 truth channels (depth_z, range, P_world.X, ...)
+    truth/<view>_ids.exr                    uint32 object_id, instance_id (0 = nothing)
+    truth/<view>_valid.png                  uint8 mask, 255 where the pixel centre's ray hit
+    truth/<view>_vignetting.exr             the imaging chain's vignetting map (channel V)
+    crossview/index.json                    what cross-view truth the run wrote
+    crossview/corr/<i>/<j>.exr              dense correspondences i -> j (u, v, z, state)
+    crossview/flow/<i>/<j>.flo              optical flow i -> j
+    crossview/twoview/<i>/<j>.json          relative pose, E, F, epipoles, plane homographies
+    crossview/matches/<i>/<j>_<kind>.npy    labelled putative matches (kind: synthetic, sift)
+    crossview/targets/<view>.json           per-view calibration-target truth
+    crossview/stereo/<left view>/<file>     rectified pair: STEREO_FILES
+
+Every name that becomes part of a path is checked here (:func:`check_name`): names read from a
+spec or from a dataset's own JSON never reach the file system unchecked.
+"""
+from __future__ import annotations
+
+import re
+
+MANIFEST = "manifest.json"
+CAMERAS = "cameras.json"
+
+# View, object and mesh names become file names: keep them portable (no separators, no '..').
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+MAX_NAME_LEN = 128
+#: A view name may not end like another view's suffixed files (view "a_ids" would clash with
+#: view "a"'s truth/a_ids.exr).
+RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting")
+MATCH_KINDS = ("synthetic", "sift")
+
+CROSSVIEW = "crossview"
+CROSSVIEW_INDEX = f"{CROSSVIEW}/index.json"
+#: Files of a rectified stereo frame, by key, with {side} = left | right.
+STEREO_FILES = {
+    "image": "{side}.png", "linear": "{side}_linear.exr", "disparity_pfm": "disp_{side}.pfm",
+    "disparity_occ": "disp_{side}_occ.png", "disparity_noc": "disp_{side}_noc.png",
+    "correspondence": "corr_{side}.exr", "map": "map_{side}.exr",
+}
+STEREO_CALIB = "calib.json"
+STEREO_SIDES = ("left", "right")
+
+
+def check_name(kind: str, name: str) -> str:
+    """``name`` if it is 1-128 characters of [A-Za-z0-9_.-] starting with a letter or digit;
+    ValueError naming ``kind`` otherwise."""
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > MAX_NAME_LEN:
+        raise ValueError(
+            f"{kind} name {name!r} must be 1-{MAX_NAME_LEN} characters from [A-Za-z0-9_.-],"
+            " starting with a letter or digit")
+    return name
+
+
+def check_view_name(view: str) -> str:
+    check_name("view", view)
+    if view.endswith(RESERVED_VIEW_SUFFIXES):
+        raise ValueError(f"view name {view!r} must not end with {RESERVED_VIEW_SUFFIXES}"
+                         " (its files would collide with another view's)")
+    return view
+
+
+def check_rel_path(rel: str) -> str:
+    """A relative POSIX path inside the dataset: not the manifest, no '..', no hidden parts."""
+    if not isinstance(rel, str) or not rel or rel.startswith("/") or "\\" in rel:
+        raise ValueError(f"dataset paths must be relative POSIX paths, got {rel!r}")
+    parts = rel.split("/")
+    if any(p in ("", ".", "..") or p.startswith(".") for p in parts):
+        raise ValueError(f"dataset path {rel!r} has an empty, '.', '..' or hidden component")
+    if rel == MANIFEST:
+        raise ValueError(f"{MANIFEST} is written by the dataset writer only")
+    return rel
+
+
+# --- per view ----------------------------------------------------------------------------------
+def view_paths(view: str) -> dict[str, str]:
+    """Relative paths of a view's standard files: keys image, linear, truth, ids, valid."""
+    check_view_name(view)
+    return {
+        "image": f"images/{view}.png",
+        "linear": f"images/{view}_linear.exr",
+        "truth": f"truth/{view}.exr",
+        "ids": f"truth/{view}_ids.exr",
+        "valid": f"truth/{view}_valid.png",
+    }
+
+
+#: The imaging chain's vignetting map of a view (one float32 channel, VIGNETTING_CHANNEL); the
+#: template is recorded in cameras.json.
+VIGNETTING_TEMPLATE = "truth/{view}_vignetting.exr"
+VIGNETTING_CHANNEL = "V"
+
+
+def vignetting_path(view: str) -> str:
+    """The imaging chain's vignetting map of a view (an extra file of the view)."""
+    return VIGNETTING_TEMPLATE.format(view=check_view_name(view))
+
+
+# --- the scene ---------------------------------------------------------------------------------
+MESHES_DIR = "scene/meshes"
+TARGETS_DIR = "scene/targets"
+
+
+def mesh_path(name: str) -> str:
+    """A world-frame mesh."""
+    return f"{MESHES_DIR}/{check_name('mesh', name)}.ply"
+
+
+def target_path(name: str) -> str:
+    """A calibration target's points (board and world frame)."""
+    return f"{TARGETS_DIR}/{check_name('target', name)}.json"
+
+
+def names_under(files, directory: str, suffix: str) -> tuple[str, ...]:
+    """Sorted names ``<name>`` of the listed files ``<directory>/<name><suffix>``."""
+    pre = directory + "/"
+    return tuple(sorted(r[len(pre):-len(suffix)] for r in files
+                        if r.startswith(pre) and r.endswith(suffix) and "/" not in r[len(pre):]))
+
+
+# --- cross-view truth --------------------------------------------------------------------------
+def correspondence_path(i: str, j: str) -> str:
+    return f"{CROSSVIEW}/corr/{check_view_name(i)}/{check_view_name(j)}.exr"
+
+
+def flow_path(i: str, j: str) -> str:
+    return f"{CROSSVIEW}/flow/{check_view_name(i)}/{check_view_name(j)}.flo"
+
+
+def twoview_path(i: str, j: str) -> str:
+    return f"{CROSSVIEW}/twoview/{check_view_name(i)}/{check_view_name(j)}.json"
+
+
+def matches_path(i: str, j: str, kind: str) -> str:
+    if kind not in MATCH_KINDS:
+        raise ValueError(f"match kind must be one of {MATCH_KINDS}, got {kind!r}")
+    return f"{CROSSVIEW}/matches/{check_view_name(i)}/{check_view_name(j)}_{kind}.npy"
+
+
+def view_targets_path(view: str) -> str:
+    return f"{CROSSVIEW}/targets/{check_view_name(view)}.json"
+
+
+def stereo_dir(left_view: str) -> str:
+    return f"{CROSSVIEW}/stereo/{check_view_name(left_view)}"
+
+
+def stereo_path(left_view: str, key: str, side: str | None = None) -> str:
+    """A file of the rectified frame of ``left_view``: ``key`` of :data:`STEREO_FILES` with a
+    side, or ``"calib"``."""
+    if key == "calib":
+        return f"{stereo_dir(left_view)}/{STEREO_CALIB}"
+    if side not in STEREO_SIDES or key not in STEREO_FILES:
+        raise ValueError(f"stereo file: key one of {list(STEREO_FILES)} or 'calib', side one of {STEREO_SIDES};"
+                         f" got {key!r}, {side!r}")
+    return f"{stereo_dir(left_view)}/{STEREO_FILES[key].format(side=side)}"

@@ -1,0 +1,231 @@
+"""Reading a dataset: typed access to everything it holds, through :mod:`.layout` and the codecs.
+
+    >>> d = Dataset("out/demo")                    # doctest: +SKIP
+    >>> len(d), d.views[0]                         # complete views, in the run's order
+    >>> camera, cam_from_world = d.camera(d.views[0])
+    >>> truth = d.truth(d.views[0])                # depth_z, range, points_world, ..., valid
+    >>> d.crossview.correspondence("a", "b")       # dense correspondences with visibility
+    >>> d.crossview.stereo("left_0000").disparity("left")
+
+Needs numpy, OpenCV and OpenEXR (trimesh for meshes); never Mitsuba. File hashes are not
+checked here: :func:`scenegen.dataset.verify.verify` does that. A missing view raises KeyError, a
+missing or unreadable file :class:`~scenegen.dataset.errors.DatasetError` naming it.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from scenegen.dataset.cameras import camera_of
+from scenegen.dataset.codecs.exr import read_exr, unpack_channels
+from scenegen.dataset.codecs.json import read_json
+from scenegen.dataset.codecs.ply import read_ply
+from scenegen.dataset.codecs.png import read_png
+from scenegen.dataset.crossview_reader import CrossviewTruth
+from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.layout import (CAMERAS, MESHES_DIR, TARGETS_DIR, check_rel_path, mesh_path, names_under,
+                                     target_path, view_paths, vignetting_path, VIGNETTING_CHANNEL)
+from scenegen.dataset.manifest import STATUS_COMPLETE, load_manifest
+from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.pose import Rigid3
+
+
+class Dataset:
+    """Read-only access to a dataset directory.
+
+    ``views`` lists the complete views in the run's order (cameras.json), ``all_views`` every
+    declared view; ``len(d)`` is the number of complete views.
+    """
+
+    def __init__(self, out_dir):
+        self.root = Path(out_dir)
+        self.manifest: dict = load_manifest(self.root)
+        self._cameras: dict | None = None
+        self._crossview: CrossviewTruth | None = None
+
+    def __repr__(self) -> str:
+        return (f"Dataset({str(self.root)!r}: {len(self.views)} of {len(self.all_views)} views complete,"
+                f" {len(self.manifest['files'])} files, variant {self.manifest['variant']})")
+
+    def __len__(self) -> int:
+        return len(self.views)
+
+    def __contains__(self, view: str) -> bool:
+        return view in self.views
+
+    # --- files
+    def path(self, rel_path: str) -> Path:
+        """The absolute path of a file of the dataset (``rel_path`` checked: no '..', no hidden)."""
+        return self.root / check_rel_path(rel_path)
+
+    def has(self, rel_path: str) -> bool:
+        """True if the manifest lists ``rel_path``."""
+        return rel_path in self.manifest["files"]
+
+    def _file(self, rel_path: str, what: str) -> Path:
+        """The path of a file the manifest lists; DatasetError saying what is missing otherwise."""
+        p = self.path(rel_path)
+        if not self.has(rel_path) or not p.is_file():
+            raise DatasetError(f"{p}: no such file in this dataset ({what})")
+        return p
+
+    def read(self, rel_path: str, reader, what: str):
+        """``reader(path)`` of a listed file; its ValueError/KeyError becomes a DatasetError."""
+        p = self._file(rel_path, what)
+        try:
+            return reader(p)
+        except (ValueError, KeyError, OSError) as e:
+            raise DatasetError(f"{p}: unreadable {what}: {e}") from None
+
+    # --- views and cameras
+    @property
+    def cameras(self) -> dict:
+        """The parsed cameras.json (empty views if the run wrote none)."""
+        if self._cameras is None:
+            p = self.root / CAMERAS
+            self._cameras = read_json(p) if p.is_file() else {"view_order": [], "views": {}, "spec": None}
+        return self._cameras
+
+    @property
+    def all_views(self) -> tuple[str, ...]:
+        order = list(self.cameras["view_order"])
+        return tuple(order + sorted(set(self.manifest["views"]) - set(order)))
+
+    @property
+    def views(self) -> tuple[str, ...]:
+        status = self.manifest["views"]
+        return tuple(v for v in self.all_views if status.get(v, {}).get("status") == STATUS_COMPLETE)
+
+    @property
+    def spec(self) -> dict | None:
+        """The resolved scene spec the run used (from cameras.json)."""
+        return self.cameras["spec"]
+
+    @property
+    def scene_name(self) -> str:
+        """The spec's scene name, else the folder's name."""
+        return str((self.spec or {}).get("name") or self.root.name)
+
+    @property
+    def objects(self) -> list[dict]:
+        """The spec's objects (resolved dicts, spec order; object ``k`` has object_id ``k + 1``)."""
+        return list((self.spec or {}).get("objects", []))
+
+    def object_id(self, name: str) -> int:
+        """The object id (>= 1) of the spec object ``name`` (KeyError if there is none)."""
+        names = [o.get("name") for o in self.objects]
+        if name not in names:
+            raise KeyError(f"no object {name!r} in this dataset's spec (objects: {', '.join(map(str, names))})")
+        return names.index(name) + 1
+
+    def check_view(self, view: str) -> str:
+        """``view`` if it is complete; KeyError saying what it is otherwise."""
+        e = self.manifest["views"].get(view)
+        if e is None or e["status"] != STATUS_COMPLETE:
+            state = "not in this dataset" if e is None else f"{e['status']}, not complete"
+            raise KeyError(f"view {view!r} is {state}")
+        return view
+
+    def view_info(self, view: str) -> dict:
+        """The view's raw cameras.json entry (camera dict, cam_from_world, rig membership)."""
+        try:
+            return self.cameras["views"][view]
+        except KeyError:
+            raise KeyError(f"view {view!r} is not in {CAMERAS}") from None
+
+    def camera(self, view: str) -> tuple[Camera, Rigid3]:
+        """``(Camera, cam_from_world)`` of a view."""
+        return camera_of(self.view_info(view))
+
+    def views_of_camera(self, camera_name: str) -> tuple[str, ...]:
+        """Complete views taken with the spec camera ``camera_name``, in view order."""
+        return tuple(v for v in self.views if self.view_info(v).get("camera_name") == camera_name)
+
+    def rig_partners(self, view: str) -> tuple[str, ...]:
+        """The other complete views of ``view``'s rig at the same frame (empty for a free camera)."""
+        info = self.view_info(view)
+        if info.get("rig") is None:
+            return ()
+        return tuple(v for v in self.views if v != view and self.view_info(v).get("rig") == info["rig"]
+                     and self.view_info(v).get("frame_index") == info.get("frame_index"))
+
+    # --- per-view files
+    def _view_file(self, view: str, key: str) -> str:
+        return view_paths(self.check_view(view))[key]
+
+    def image(self, view: str) -> np.ndarray:
+        """The rendered image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16."""
+        return self.read(self._view_file(view, "image"), read_png, f"image of view {view!r}")
+
+    def linear_image(self, view: str) -> np.ndarray:
+        """Clean linear radiance, (H, W, 3) float32 RGB."""
+        ch = self.read(self._view_file(view, "linear"), read_exr, f"linear image of view {view!r}")
+        return unpack_channels(ch, "", LINEAR_CHANNELS)
+
+    def truth_channels(self, view: str) -> dict[str, np.ndarray]:
+        """The float truth EXR of a view, channel name -> (H, W) float32 (no ids, no mask)."""
+        return self.read(self._view_file(view, "truth"), read_exr, f"truth of view {view!r}")
+
+    def truth(self, view: str) -> dict[str, np.ndarray]:
+        """Per-pixel truth of the ray through each pixel centre (keys
+        :data:`scenegen.dataset.truth.TRUTH_KEYS`): depth_z, range (H, W) float32 metres (+inf on
+        misses); points_world, points_cam, normals_world, normals_cam (H, W, 3) float32 (NaN on
+        misses); uv (H, W, 2) float32; object_id, instance_id (H, W) uint32 (0 = none); valid
+        (H, W) bool."""
+        what = f"truth of view {view!r}"
+        ids = self.read(self._view_file(view, "ids"), read_exr, what)
+        valid = self.read(self._view_file(view, "valid"), read_png, what)
+        try:
+            return decode_truth(self.truth_channels(view), ids, valid)
+        except KeyError as e:
+            raise DatasetError(f"{self.path(self._view_file(view, 'truth'))}: {e.args[0]}") from None
+
+    def depth_z(self, view: str) -> np.ndarray:
+        """(H, W) float32 z-depth, metres; +inf where the ray hit nothing."""
+        return self._truth_channel(view, "depth_z")
+
+    def points_world(self, view: str) -> np.ndarray:
+        """(H, W, 3) float32 world points, metres; NaN where the ray hit nothing."""
+        return self._truth_channel(view, "points_world")
+
+    def _truth_channel(self, view: str, key: str) -> np.ndarray:
+        prefix, comps = TRUTH_FLOAT_CHANNELS[key]
+        ch = self.truth_channels(view)
+        try:
+            return ch[prefix] if comps is None else unpack_channels(ch, prefix, comps)
+        except KeyError as e:
+            raise DatasetError(f"{self.path(self._view_file(view, 'truth'))}: no channel(s) for {key} ({e})") from None
+
+    def vignetting(self, view: str) -> np.ndarray | None:
+        """(H, W) float32 vignetting map of the imaging chain, or None if the camera has none."""
+        rel = vignetting_path(self.check_view(view))
+        return read_exr(self.path(rel))[VIGNETTING_CHANNEL] if self.has(rel) else None
+
+    # --- the scene
+    @property
+    def mesh_names(self) -> tuple[str, ...]:
+        return names_under(self.manifest["files"], MESHES_DIR, ".ply")
+
+    @property
+    def target_names(self) -> tuple[str, ...]:
+        """Objects that are calibration targets (with points in scene/targets/)."""
+        return names_under(self.manifest["files"], TARGETS_DIR, ".json")
+
+    def mesh(self, name: str):
+        """A world-frame mesh as a trimesh.Trimesh."""
+        return self.read(mesh_path(name), read_ply, f"mesh of object {name!r}")
+
+    def target(self, name: str) -> dict:
+        """A calibration target's points: kind, point_ids, points_board, points_world (metres),
+        world_from_board, marker ids and corners for ChArUco/ArUco boards."""
+        return self.read(target_path(name), read_json, f"points of target {name!r}")
+
+    # --- cross-view truth
+    @property
+    def crossview(self) -> CrossviewTruth:
+        """The cross-view truth (docs/crossview.md); ``crossview.index`` is None without any."""
+        if self._crossview is None:
+            self._crossview = CrossviewTruth(self)
+        return self._crossview

@@ -1,0 +1,126 @@
+"""Per-pixel truth of a view as stored: the keys, their channels, the rules, encode and decode.
+
+Keys (:data:`TRUTH_KEYS`), all over the view's pixel centres, (H, W) or (H, W, C):
+
+* ``depth_z`` (H, W) metres along the optical axis; ``range`` (H, W) metres from the optical
+  centre (+inf where the ray hit nothing);
+* ``points_world`` / ``points_cam`` (H, W, 3) metres, world / OpenCV camera frame;
+* ``normals_world`` / ``normals_cam`` (H, W, 3) unit shading normals (not flipped to the viewer);
+* ``uv`` (H, W, 2) texture coordinates (v = 0 at the texture's top row);
+* ``object_id`` / ``instance_id`` (H, W) uint32, 0 = no object; ``valid`` (H, W) bool.
+
+Misses (``~valid``) carry depth_z = range = +inf, NaN points, normals and uv, and ids 0.
+Files: ``truth/<view>.exr`` (float32 channels of :data:`TRUTH_FLOAT_CHANNELS`),
+``truth/<view>_ids.exr`` (uint32), ``truth/<view>_valid.png`` (uint8, 255 = valid).
+"""
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from scenegen.dataset.codecs.exr import encode_exr, pack_channels, unpack_channels
+from scenegen.dataset.codecs.png import encode_png
+
+#: Truth key -> (EXR channel prefix, component names); components None = a scalar channel.
+TRUTH_FLOAT_CHANNELS: dict[str, tuple[str, tuple[str, ...] | None]] = {
+    "depth_z": ("depth_z", None),  # (H, W) metres along the optical axis
+    "range": ("range", None),  # (H, W) metres from the optical centre
+    "points_world": ("P_world", ("X", "Y", "Z")),  # (H, W, 3) metres, world frame
+    "points_cam": ("P_cam", ("X", "Y", "Z")),  # (H, W, 3) metres, OpenCV camera frame
+    "normals_world": ("N_world", ("X", "Y", "Z")),  # (H, W, 3) unit, world frame
+    "normals_cam": ("N_cam", ("X", "Y", "Z")),  # (H, W, 3) unit, camera frame
+    "uv": ("uv", ("U", "V")),  # (H, W, 2) texture coordinates
+}
+TRUTH_ID_KEYS = ("object_id", "instance_id")  # (H, W) uint32, 0 = no object
+#: Every key of a truth dict (writer input and reader output).
+TRUTH_KEYS = tuple(TRUTH_FLOAT_CHANNELS) + TRUTH_ID_KEYS + ("valid",)
+_UINT32_MAX = np.iinfo(np.uint32).max
+VALID_PNG_VALUE = 255  # a valid pixel in truth/<view>_valid.png
+#: The linear image's channels (images/<view>_linear.exr).
+LINEAR_CHANNELS = ("R", "G", "B")
+
+
+def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None) -> dict:
+    """Validate a truth dict (keys :data:`TRUTH_KEYS`) and return it with arrays as stored.
+
+    Float keys may be any float dtype; they are stored, and returned, as float32 (float64 input,
+    e.g. from the truth pass, is rounded to nearest: about 6e-8 relative, far below 1e-3 px of
+    reprojection error). ``object_id``/``instance_id``: integers in [0, 2^32) (returned as
+    uint32); ``valid``: bool. Shapes: (H, W), (H, W, 3) for points and normals, (H, W, 2) for uv; ``shape`` (H, W)
+    if given. Misses (``~valid``) must carry depth_z = range = +inf, NaN points, normals and uv,
+    and ids 0; hits finite depth_z, range, points and normals.
+    """
+    missing = [k for k in TRUTH_KEYS if k not in truth]
+    extra = [k for k in truth if k not in TRUTH_KEYS]
+    if missing or extra:
+        raise ValueError(f"truth keys: missing {missing}, unknown {extra}; expected {list(TRUTH_KEYS)}")
+    valid = np.asarray(truth["valid"])
+    if valid.dtype != np.bool_ or valid.ndim != 2:
+        raise TypeError(f"truth 'valid' must be an (H, W) bool array, got {valid.dtype} {valid.shape}")
+    hw = valid.shape
+    if shape is not None and tuple(shape) != hw:
+        raise ValueError(f"truth is {hw} (H, W) but the image is {tuple(shape)}")
+    out: dict[str, np.ndarray] = {"valid": valid}
+    miss = ~valid
+    for key, (_, comps) in TRUTH_FLOAT_CHANNELS.items():
+        a = np.asarray(truth[key])
+        want = hw if comps is None else hw + (len(comps),)
+        if not np.issubdtype(a.dtype, np.floating):
+            raise TypeError(f"truth {key!r} must be a float array (stored as float32), got {a.dtype}")
+        if a.shape != want:
+            raise ValueError(f"truth {key!r} must have shape {want}, got {a.shape}")
+        a = a.astype(np.float32, copy=False)
+        if key in ("depth_z", "range"):
+            if not np.all(a[miss] == np.inf):
+                raise ValueError(f"truth {key!r} must be +inf where valid is False")
+        elif not np.all(np.isnan(a[miss])):
+            raise ValueError(f"truth {key!r} must be NaN where valid is False")
+        if key != "uv" and not np.all(np.isfinite(a[valid])):
+            raise ValueError(f"truth {key!r} must be finite where valid is True")
+        out[key] = a
+    for key in TRUTH_ID_KEYS:
+        a = np.asarray(truth[key])
+        if not np.issubdtype(a.dtype, np.integer) or a.shape != hw:
+            raise TypeError(f"truth {key!r} must be an integer (H, W) = {hw} array, got {a.dtype} {a.shape}")
+        if a.size and (a.min() < 0 or a.max() > _UINT32_MAX):
+            raise ValueError(f"truth {key!r} values must lie in [0, 2^32 - 1]")
+        a = a.astype(np.uint32, copy=False)
+        if np.any(a[miss] != 0):
+            raise ValueError(f"truth {key!r} must be 0 where valid is False")
+        out[key] = a
+    return out
+
+
+def truth_float_channels(truth: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The float EXR channels of a checked truth dict."""
+    ch: dict[str, np.ndarray] = {}
+    for key, (prefix, comps) in TRUTH_FLOAT_CHANNELS.items():
+        if comps is None:
+            ch[prefix] = truth[key]
+        else:
+            ch.update(pack_channels(prefix, truth[key], comps))
+    return ch
+
+
+def encode_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None) -> dict[str, bytes]:
+    """The three truth files of a view, by key ``truth``, ``ids``, ``valid`` (see the module
+    docstring); ``truth`` is checked with :func:`check_truth` first."""
+    t = check_truth(truth, shape=shape)
+    return {
+        "truth": encode_exr(truth_float_channels(t)),
+        "ids": encode_exr({k: t[k] for k in TRUTH_ID_KEYS}),
+        "valid": encode_png(np.where(t["valid"], np.uint8(VALID_PNG_VALUE), np.uint8(0))),
+    }
+
+
+def decode_truth(float_channels: Mapping[str, np.ndarray], id_channels: Mapping[str, np.ndarray],
+                 valid_png: np.ndarray) -> dict[str, np.ndarray]:
+    """The truth dict of a view from its decoded files (inverse of :func:`encode_truth`)."""
+    out: dict[str, np.ndarray] = {}
+    for key, (prefix, comps) in TRUTH_FLOAT_CHANNELS.items():
+        out[key] = float_channels[prefix] if comps is None else unpack_channels(float_channels, prefix, comps)
+    for key in TRUTH_ID_KEYS:
+        out[key] = id_channels[key]
+    out["valid"] = np.asarray(valid_png) == VALID_PNG_VALUE
+    return out

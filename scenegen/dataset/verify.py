@@ -1,0 +1,97 @@
+"""``scenegen verify``: re-hash every file listed in a dataset's manifest and compare the folder
+with it (missing, corrupted and unexpected files, incomplete views, inconsistent listings)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from scenegen.dataset.codecs.json import read_json
+from scenegen.dataset.files import sha256_file
+from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, view_paths
+from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION, STATUS_COMPLETE, manifest_integrity_error
+
+
+@dataclass(frozen=True, kw_only=True)
+class VerifyReport:
+    """Result of :func:`verify`. Paths are relative POSIX paths, sorted."""
+
+    ok: bool  # True iff every list below is empty
+    missing: tuple[str, ...]  # listed in the manifest, absent on disk
+    corrupted: tuple[str, ...]  # present, but the bytes differ from the recorded sha256
+    unexpected: tuple[str, ...]  # on disk but not listed (e.g. files of unfinished views)
+    incomplete_views: tuple[str, ...]  # declared views not marked complete
+    problems: tuple[str, ...]  # anything else (unreadable manifest, inconsistent listings)
+    files_checked: int  # number of files re-hashed
+
+    def summary(self) -> str:
+        lines = [f"{'OK' if self.ok else 'FAILED'}: {self.files_checked} files checked"]
+        for label, items in (("missing", self.missing), ("corrupted", self.corrupted),
+                             ("unexpected", self.unexpected),
+                             ("incomplete views", self.incomplete_views), ("problems", self.problems)):
+            if items:
+                lines.append(f"{label} ({len(items)}):")
+                lines.extend(f"  {x}" for x in items)
+        return "\n".join(lines)
+
+
+def _report(missing=(), corrupted=(), unexpected=(), incomplete=(), problems=(), checked=0):
+    lists = [tuple(sorted(x)) for x in (missing, corrupted, unexpected, incomplete)]
+    return VerifyReport(ok=not any(lists) and not problems, missing=lists[0], corrupted=lists[1],
+                        unexpected=lists[2], incomplete_views=lists[3], problems=tuple(problems),
+                        files_checked=checked)
+
+
+def verify(out_dir) -> VerifyReport:
+    """Re-hash every file listed in the manifest and compare the directory with it.
+
+    The manifest checks itself (``manifest_sha256``); if it is corrupt nothing else can be
+    trusted, and only ``manifest.json`` is reported.
+    """
+    root = Path(out_dir)
+    mpath = root / MANIFEST
+    if not root.is_dir():
+        return _report(problems=[f"{root} is not a directory"])
+    if not mpath.is_file():
+        return _report(missing=[MANIFEST], problems=[f"no {MANIFEST}: not a scenegen dataset"])
+    m, err = manifest_integrity_error(mpath.read_bytes())
+    if err:
+        return _report(corrupted=[MANIFEST],
+                       problems=[f"{MANIFEST}: {err}; other files not checked"])
+    problems = []
+    if m["format"] != FORMAT or m["format_version"] != FORMAT_VERSION:
+        problems.append(f"format {m['format']!r} version {m['format_version']!r} is not"
+                        f" {FORMAT!r} version {FORMAT_VERSION}")
+
+    missing, corrupted = [], []
+    for rel, sha in m["files"].items():
+        try:
+            check_rel_path(rel)
+        except ValueError as e:
+            problems.append(str(e))
+            continue
+        p = root / rel
+        if not p.is_file():
+            missing.append(rel)
+        elif sha256_file(p) != sha:
+            corrupted.append(rel)
+    listed = set(m["files"]) | {MANIFEST}
+    unexpected = [p.relative_to(root).as_posix() for p in root.rglob("*")
+                  if p.is_file() and p.relative_to(root).as_posix() not in listed]
+
+    incomplete = [v for v, e in m["views"].items() if e.get("status") != STATUS_COMPLETE]
+    for v, e in m["views"].items():
+        if e.get("status") == STATUS_COMPLETE:
+            unlisted = sorted(set(view_paths(v).values()) - set(e.get("files", [])))
+            unlisted += [r for r in e.get("files", []) if r not in m["files"]]
+            if unlisted:
+                problems.append(f"view {v!r} is complete but has no hash for {unlisted}")
+    if CAMERAS in m["files"] and CAMERAS not in missing + corrupted:
+        try:
+            declared = read_json(root / CAMERAS)["view_order"]
+        except (ValueError, KeyError, TypeError) as e:
+            problems.append(f"{CAMERAS}: unreadable ({e})")
+        else:
+            undeclared = sorted(set(declared) - set(m["views"]))
+            if undeclared:
+                problems.append(f"views in {CAMERAS} but not in {MANIFEST}: {undeclared}")
+    return _report(missing, corrupted, unexpected, incomplete, problems, checked=len(m["files"]))

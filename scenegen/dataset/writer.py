@@ -1,0 +1,304 @@
+"""Writing a dataset: encode a view's files, write them atomically, hash them, keep the manifest.
+
+Crash safety: every file is written atomically (:mod:`scenegen.dataset.files`), and the manifest,
+rewritten atomically after each completed view, lists a view as ``complete`` only after all of
+its files are on disk, so a run killed at any point leaves a consistent dataset that
+``resume=True`` can finish. Same spec, seed, variant and software: byte-identical datasets,
+whatever the order in which views were written.
+"""
+from __future__ import annotations
+
+import platform
+import re
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Mapping
+
+import cv2
+import numpy as np
+
+from scenegen.dataset.cameras import ViewCamera, cameras_document
+from scenegen.dataset.codecs.exr import encode_exr, pack_channels
+from scenegen.dataset.codecs.json import decode_json, encode_json
+from scenegen.dataset.codecs.ply import encode_ply
+from scenegen.dataset.codecs.png import encode_png
+from scenegen.dataset.errors import DatasetError, DatasetMismatchError
+from scenegen.dataset.files import atomic_write_bytes, remove_stale_temp_files, sha256_bytes
+from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, check_view_name, mesh_path, view_paths
+from scenegen.dataset.manifest import (FORMAT, FORMAT_VERSION, IDENTITY_KEYS, STATUS_COMPLETE, STATUS_PENDING,
+                                       load_manifest, manifest_bytes)
+from scenegen.dataset.truth import LINEAR_CHANNELS, encode_truth
+
+
+def encode_view(view: str, *, image: np.ndarray, linear_rgb: np.ndarray,
+                truth: Mapping[str, np.ndarray]) -> dict[str, bytes]:
+    """Encode one view's files: ``{relative path: bytes}`` (pure; writes nothing).
+
+    image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16 (the rendered, possibly corrupted image).
+    linear_rgb: (H, W, 3) float, clean linear radiance (stored as float32).
+    truth: see :func:`check_truth`.
+    """
+    paths = view_paths(view)
+    image = np.asarray(image)
+    hw = image.shape[:2]
+    linear_rgb = np.asarray(linear_rgb)
+    if not np.issubdtype(linear_rgb.dtype, np.floating) or linear_rgb.shape != hw + (3,):
+        raise ValueError(f"linear_rgb must be a float {hw + (3,)} array, got {linear_rgb.dtype}"
+                         f" {linear_rgb.shape}")
+    linear_rgb = linear_rgb.astype(np.float32, copy=False)
+    truth_files = encode_truth(truth, shape=hw)
+    return {
+        paths["image"]: encode_png(image),
+        paths["linear"]: encode_exr(pack_channels("", linear_rgb, LINEAR_CHANNELS)),
+        **{paths[k]: data for k, data in truth_files.items()},
+    }
+
+
+def _checked_extra_files(view: str, extra_files: Mapping[str, bytes] | None,
+                         standard: Mapping[str, Any]) -> dict[str, bytes]:
+    extra = {}
+    for rel, data in (extra_files or {}).items():
+        check_rel_path(rel)
+        if rel in standard or rel == CAMERAS:
+            raise ValueError(f"extra file {rel!r} of view {view!r} collides with a standard file")
+        if not isinstance(data, (bytes, bytearray, memoryview)):
+            raise TypeError(f"extra file {rel!r}: pass encoded bytes (see scenegen.dataset.codecs)")
+        extra[rel] = bytes(data)
+    return extra
+
+
+def write_view_files(out_dir, view: str, *, image, linear_rgb, truth,
+                     extra_files: Mapping[str, bytes] | None = None) -> dict[str, str]:
+    """Write one view's files atomically under ``out_dir``; return ``{relative path: sha256}``.
+
+    Does not touch the manifest: for a worker process, whose result the process owning the
+    :class:`DatasetWriter` then records with :meth:`DatasetWriter.record_view`.
+    ``extra_files`` maps further relative paths to encoded bytes, hashed and listed with the view.
+    """
+    files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
+    files.update(_checked_extra_files(view, extra_files, files))
+    root = Path(out_dir)
+    hashes = {}
+    for rel, data in files.items():
+        atomic_write_bytes(root / rel, data)
+        hashes[rel] = sha256_bytes(data)
+    return hashes
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of the software that determine the output bytes (without importing Mitsuba)."""
+    def dist_version(name: str) -> str:
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return "not installed"
+
+    return {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "opencv": cv2.__version__,
+        "mitsuba": dist_version("mitsuba"),
+        "drjit": dist_version("drjit"),
+        "openexr": dist_version("OpenEXR"),
+        "trimesh": dist_version("trimesh"),
+        "scenegen": dist_version("scenegen"),
+    }
+
+
+class DatasetWriter:
+    """Writes a dataset directory; owns its manifest (use one writer per directory).
+
+    Typical use::
+
+        w = DatasetWriter(out, spec_sha256=h, seed=s, variant=v, versions=software_versions(),
+                          resume=args.resume)
+        w.write_cameras(view_cameras, resolved_spec)     # declares every view (status pending)
+        for name, mesh in world_meshes.items():
+            w.write_mesh(name, mesh)
+        for view in view_cameras:
+            if w.is_complete(view):
+                continue                                  # done by an earlier, interrupted run
+            w.write_view(view, image=img, linear_rgb=lin, truth=truth)
+
+    ``resume=False`` needs ``out_dir`` absent or empty. ``resume=True`` loads an existing manifest,
+    which must have been written with the same spec_sha256, seed, variant, format and versions
+    (else :class:`DatasetMismatchError`), removes temporary files left by a killed run, and keeps
+    the completed views; a directory without a manifest is started afresh if it is empty.
+    Re-writing a file that is already recorded with different content raises
+    :class:`DatasetMismatchError` before anything is written: outputs must be deterministic.
+    """
+
+    def __init__(self, out_dir, *, spec_sha256: str, seed: int, variant: str,
+                 versions: Mapping[str, str], resume: bool = False):
+        self.root = Path(out_dir)
+        if not (isinstance(spec_sha256, str) and re.fullmatch(r"[0-9a-f]{64}", spec_sha256)):
+            raise ValueError(f"spec_sha256 must be 64 lower-case hex digits, got {spec_sha256!r}")
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+            raise TypeError(f"seed must be an int, got {seed!r}")
+        identity = {
+            "format": FORMAT, "format_version": FORMAT_VERSION, "spec_sha256": spec_sha256,
+            "seed": int(seed), "variant": str(variant),
+            "versions": {str(k): str(v) for k, v in versions.items()},
+        }
+        self._identity = identity
+        self._views: dict[str, dict] = {}  # view -> {"status": ..., "files": [...]}
+        self._files: dict[str, str] = {}  # relative path -> sha256
+        self._view_order: list[str] = []
+
+        has_manifest = (self.root / MANIFEST).is_file()
+        if resume and self.root.is_dir():
+            remove_stale_temp_files(self.root)
+        if resume and has_manifest:
+            m = load_manifest(self.root)
+            diffs = [f"{k}: dataset has {m[k]!r}, this run has {identity[k]!r}"
+                     for k in IDENTITY_KEYS if m[k] != identity[k]]
+            if diffs:
+                raise DatasetMismatchError(
+                    f"cannot resume {self.root}: it was written by a different run\n  "
+                    + "\n  ".join(diffs) + "\nUse a new output directory.")
+            self._views = {v: {"status": e["status"], "files": list(e["files"])}
+                           for v, e in m["views"].items()}
+            self._files = dict(m["files"])
+        elif self.root.exists() and any(self.root.iterdir()):
+            hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
+            raise DatasetError(f"{self.root} is not empty ({hint}); use a new or empty directory")
+        self._write_manifest()
+
+    # --- state
+    def is_complete(self, view: str) -> bool:
+        """True if ``view`` was fully written (by this or an earlier, interrupted run)."""
+        e = self._views.get(view)
+        return e is not None and e["status"] == STATUS_COMPLETE
+
+    @property
+    def completed_views(self) -> tuple[str, ...]:
+        return tuple(sorted(v for v in self._views if self.is_complete(v)))
+
+    @property
+    def manifest(self) -> dict:
+        """The manifest as last written (a fresh copy)."""
+        return decode_json(self._manifest_bytes())
+
+    # --- writing
+    def write_cameras(self, views: Mapping[str, ViewCamera], spec: Mapping[str, Any]) -> None:
+        """Write cameras.json for every view of the run, in order, and the resolved spec dict.
+
+        Declares each view in the manifest (status ``pending`` until written).
+        """
+        doc = cameras_document(views, spec)
+        self.write_file(CAMERAS, encode_json(doc), _flush=False)
+        for name in doc["view_order"]:
+            self._views.setdefault(name, {"status": STATUS_PENDING, "files": []})
+        self._write_manifest()
+
+    def write_mesh(self, name: str, mesh, *, vertex_normals: bool = False) -> str:
+        """Write a world-frame trimesh as binary PLY at ``scene/meshes/<name>.ply``.
+
+        trimesh stores vertices as float32 (the precision Mitsuba renders with); UVs and vertex
+        colours are kept; vertex normals only if ``vertex_normals``. Returns the relative path.
+        """
+        rel = mesh_path(name)
+        self.write_file(rel, encode_ply(mesh, vertex_normals=vertex_normals))
+        return rel
+
+    def write_file(self, rel_path: str, data: bytes, *, _flush: bool = True) -> str:
+        """Write a dataset-level file (not tied to a view), atomically and hashed; returns its
+        sha256. For example a calibration target's corner points as JSON."""
+        check_rel_path(rel_path)
+        sha = sha256_bytes(data)
+        old = self._files.get(rel_path)
+        if old is not None and old != sha:
+            raise DatasetMismatchError(
+                f"{rel_path} is already recorded in {self.root} with different content"
+                f" (sha256 {old[:12]}... != {sha[:12]}...): outputs are not deterministic, or the"
+                " dataset belongs to another run")
+        atomic_write_bytes(self.root / rel_path, data)
+        self._files[rel_path] = sha
+        if _flush:
+            self._write_manifest()
+        return sha
+
+    def write_view(self, view: str, *, image, linear_rgb, truth,
+                   extra_files: Mapping[str, bytes] | None = None) -> None:
+        """Encode, write and hash one view's files, then mark it complete in the manifest.
+
+        Arguments as in :func:`encode_view`; ``extra_files`` as in :func:`write_view_files`.
+        """
+        files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
+        files.update(_checked_extra_files(view, extra_files, files))
+        hashes = {rel: sha256_bytes(d) for rel, d in files.items()}
+        self._check_rerecord(view, hashes)  # before writing anything
+        for rel, data in files.items():
+            atomic_write_bytes(self.root / rel, data)
+        self.record_view(view, hashes)
+
+    def record_view(self, view: str, file_hashes: Mapping[str, str]) -> None:
+        """Mark ``view`` complete with the files (``{relative path: sha256}``) already written,
+        e.g. by :func:`write_view_files` in a worker; rewrites the manifest atomically."""
+        self._record(view, file_hashes)
+        self._write_manifest()
+
+    def record_views(self, views: Mapping[str, Mapping[str, str]]) -> None:
+        """:meth:`record_view` for several views (``{view: {relative path: sha256}}``, in order)
+        with one manifest rewrite: the manifest's size grows with the run, so a client recording
+        many workers' views batches what is ready. Nothing is recorded if any view is invalid."""
+        views = dict(views)
+        snapshot = ({v: {"status": e["status"], "files": list(e["files"])} for v, e in self._views.items()},
+                    dict(self._files))
+        try:
+            for view, file_hashes in views.items():
+                self._record(view, file_hashes)
+        except Exception:
+            self._views, self._files = snapshot
+            raise
+        self._write_manifest()
+
+    def _record(self, view: str, file_hashes: Mapping[str, str]) -> None:
+        check_view_name(view)
+        for rel, sha in file_hashes.items():
+            check_rel_path(rel)
+            if not (isinstance(sha, str) and re.fullmatch(r"[0-9a-f]{64}", sha)):
+                raise ValueError(f"{rel}: sha256 must be 64 lower-case hex digits, got {sha!r}")
+        missing = sorted(set(view_paths(view).values()) - set(file_hashes))
+        if missing:
+            raise ValueError(f"view {view!r}: no hash for {missing}")
+        self._check_rerecord(view, file_hashes)
+        for rel in self._views.get(view, {}).get("files", []):
+            self._files.pop(rel, None)
+        self._files.update(file_hashes)
+        self._views[view] = {"status": STATUS_COMPLETE, "files": sorted(file_hashes)}
+
+    def close(self) -> None:
+        """Write the manifest a last time (every method already leaves it up to date)."""
+        self._write_manifest()
+
+    def __enter__(self) -> "DatasetWriter":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- internals
+    def _check_rerecord(self, view: str, hashes: Mapping[str, str]) -> None:
+        check_view_name(view)
+        if self.is_complete(view):
+            old = {rel: self._files.get(rel) for rel in self._views[view]["files"]}
+            if old != dict(hashes):
+                changed = sorted(r for r in set(old) | set(hashes) if old.get(r) != hashes.get(r))
+                raise DatasetMismatchError(
+                    f"view {view!r} is already complete in {self.root} with different files"
+                    f" {changed}: outputs are not deterministic, or the dataset belongs to another run")
+        own = set(self._views.get(view, {}).get("files", []))
+        taken = sorted(rel for rel in hashes if rel in self._files and rel not in own)
+        if taken:
+            raise ValueError(f"view {view!r}: files {taken} already belong to another view or the dataset")
+
+    def _manifest_bytes(self) -> bytes:
+        body = dict(self._identity)
+        body["views"] = {v: {"status": e["status"], "files": sorted(e["files"])}
+                         for v, e in self._views.items()}
+        body["files"] = dict(self._files)
+        return manifest_bytes(body)
+
+    def _write_manifest(self) -> None:
+        atomic_write_bytes(self.root / MANIFEST, self._manifest_bytes())

@@ -1,0 +1,143 @@
+"""Every convention of the project, stated once, and the one conversion to each foreign one.
+
+Internal conventions (used everywhere in scenegen and recon_eval):
+
+* Camera axes: OpenCV. +x right, +y down, +z forward (the optical axis). A pose is
+  ``cam_from_world`` (``x_cam = R x_world + t``), see :mod:`scenegen.geometry.pose`.
+* Units: metres; radians inside the code, degrees only at the user's edges (spec fields and result
+  fields named ``*_deg``).
+* Pixels: OpenCV. The CENTRE of the top-left pixel is (u, v) = (0, 0); u grows to the right along
+  columns, v down along rows; the image spans [-0.5, W - 0.5] x [-0.5, H - 0.5].
+* Depth is z along the optical axis (``depth_z``); range is the Euclidean distance from the optical
+  centre (``range``). ``range = depth_z * |(x, y, 1)|`` for the z = 1 ray (x, y, 1).
+* Quaternions are (w, x, y, z), scalar first (COLMAP's order).
+* Texture UVs: u along texture columns, v along rows with v = 0 at the top row (image row 0).
+
+Foreign conventions, one function (or constant) each:
+
+* COLMAP pixels: the top-left pixel's centre is (0.5, 0.5): ``colmap = opencv + 0.5``.
+* Mitsuba film: sample position s in [0, 1]^2 over the image, pixel i covers [i, i + 1] in film
+  pixel units, so ``u = s_x * W - 0.5``. Mitsuba camera axes: +x LEFT, +y UP, +z forward (a 180
+  degree rotation about z from OpenCV). Its ``to_world`` is camera-to-world.
+* OpenGL / NeRF (instant-ngp, nerfstudio ``transforms.json``): camera-to-world 4x4 with camera axes
+  +x right, +y up, +z backward (the camera looks down -z).
+* Blender: a camera object's ``matrix_world`` uses the OpenGL camera axes; Blender's world is the
+  same right-handed Z-up world as ours, so no world change is needed.
+* COLMAP poses: ``cam_from_world`` as a wxyz quaternion and a translation (images.txt).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.rotation import matrix_from_quat_wxyz, quat_wxyz_from_matrix
+
+# --- camera axes -----------------------------------------------------------------------------
+#: x_mitsuba_cam = MITSUBA_FROM_OPENCV_CAM @ x_opencv_cam (x left, y up, z forward).
+MITSUBA_FROM_OPENCV_CAM = np.diag([-1.0, -1.0, 1.0])
+#: x_opengl_cam = OPENGL_FROM_OPENCV_CAM @ x_opencv_cam (x right, y up, z backward).
+OPENGL_FROM_OPENCV_CAM = np.diag([1.0, -1.0, -1.0])
+
+
+def _camera_to_world(cam_from_world: Rigid3, foreign_from_opencv: np.ndarray) -> np.ndarray:
+    """4x4 camera-to-world of a camera frame with other axes (x_foreign = A x_opencv)."""
+    world_from_cam = cam_from_world.inverse()
+    T = np.eye(4)
+    T[:3, :3] = world_from_cam.R @ foreign_from_opencv.T
+    T[:3, 3] = world_from_cam.t
+    return T
+
+
+def _cam_from_world(camera_to_world, foreign_from_opencv: np.ndarray) -> Rigid3:
+    T = np.asarray(camera_to_world, dtype=np.float64)
+    return Rigid3(T[:3, :3] @ foreign_from_opencv, T[:3, 3]).inverse()
+
+
+def mitsuba_to_world(cam_from_world: Rigid3) -> np.ndarray:
+    """Mitsuba sensor ``to_world`` (4x4, Mitsuba camera -> world) for an OpenCV ``cam_from_world``."""
+    return _camera_to_world(cam_from_world, MITSUBA_FROM_OPENCV_CAM)
+
+
+def cam_from_world_from_mitsuba(to_world) -> Rigid3:
+    """Inverse of :func:`mitsuba_to_world`."""
+    return _cam_from_world(to_world, MITSUBA_FROM_OPENCV_CAM)
+
+
+def opengl_cam_to_world(cam_from_world: Rigid3) -> np.ndarray:
+    """OpenGL/NeRF camera-to-world 4x4 (``transform_matrix`` of transforms.json); also Blender's
+    camera ``matrix_world``."""
+    return _camera_to_world(cam_from_world, OPENGL_FROM_OPENCV_CAM)
+
+
+def cam_from_world_from_opengl(cam_to_world) -> Rigid3:
+    """Inverse of :func:`opengl_cam_to_world`."""
+    return _cam_from_world(cam_to_world, OPENGL_FROM_OPENCV_CAM)
+
+
+# Blender cameras use the OpenGL camera axes in a Z-up world identical to ours.
+blender_matrix_world = opengl_cam_to_world
+cam_from_world_from_blender = cam_from_world_from_opengl
+
+
+# --- COLMAP poses ------------------------------------------------------------------------------
+def colmap_pose(cam_from_world: Rigid3) -> tuple[np.ndarray, np.ndarray]:
+    """(qvec_wxyz, tvec) as written in COLMAP's images.txt (cam_from_world)."""
+    return quat_wxyz_from_matrix(cam_from_world.R), cam_from_world.t.copy()
+
+
+def cam_from_world_from_colmap(qvec_wxyz, tvec) -> Rigid3:
+    return Rigid3(matrix_from_quat_wxyz(qvec_wxyz), tvec)
+
+
+# --- pixels -----------------------------------------------------------------------------------
+def colmap_from_opencv_pixels(uv):
+    """COLMAP image coordinates (top-left pixel centre at 0.5) from OpenCV pixels."""
+    return np.asarray(uv, dtype=np.float64) + 0.5
+
+
+def opencv_from_colmap_pixels(uv):
+    return np.asarray(uv, dtype=np.float64) - 0.5
+
+
+def opencv_pixel_from_film(sample, size, offset=(0, 0)):
+    """OpenCV pixel from Mitsuba's film sample position in [0, 1]^2 over a crop window.
+
+    ``size`` is the crop size (W, H) and ``offset`` its top-left pixel (both (0, 0) and the full
+    image without cropping). Works on numpy and Dr.Jit values alike (only arithmetic).
+    """
+    return sample[0] * size[0] + offset[0] - 0.5, sample[1] * size[1] + offset[1] - 0.5
+
+
+def film_from_opencv_pixel(uv, size):
+    """Mitsuba film sample position in [0, 1]^2 for an OpenCV pixel (inverse of the above)."""
+    return (uv[0] + 0.5) / size[0], (uv[1] + 0.5) / size[1]
+
+
+def in_image(uv, width: int, height: int) -> np.ndarray:
+    """(N,) bool: OpenCV pixel positions (N, 2) inside the image area [-0.5, W - 0.5] x
+    [-0.5, H - 0.5] (edges included; NaN is outside)."""
+    uv = np.asarray(uv, float)
+    with np.errstate(invalid="ignore"):
+        return (uv[:, 0] >= -0.5) & (uv[:, 0] <= width - 0.5) & (uv[:, 1] >= -0.5) & (uv[:, 1] <= height - 0.5)
+
+
+def corner_pixel_centers(width: int, height: int) -> np.ndarray:
+    """(4, 2) the corner pixels' centres: (0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)."""
+    return np.array([[0.0, 0.0], [width - 1.0, 0.0], [0.0, height - 1.0], [width - 1.0, height - 1.0]])
+
+
+def pixel_centers(width: int, height: int) -> np.ndarray:
+    """(H, W, 2) float64 OpenCV coordinates of every pixel centre: [v, u] -> (u, v) = (u, v)."""
+    u, v = np.meshgrid(np.arange(width, dtype=np.float64), np.arange(height, dtype=np.float64))
+    return np.stack([u, v], axis=-1)
+
+
+# --- depth vs range ---------------------------------------------------------------------------
+def range_from_depth_z(depth_z, rays_z1):
+    """Range (distance from the optical centre) from z-depth along z = 1 rays (..., 3)."""
+    return np.asarray(depth_z) * np.linalg.norm(np.asarray(rays_z1), axis=-1)
+
+
+def depth_z_from_range(range_m, rays_z1):
+    """z-depth from range along z = 1 rays (..., 3) (x, y, 1)."""
+    return np.asarray(range_m) / np.linalg.norm(np.asarray(rays_z1), axis=-1)

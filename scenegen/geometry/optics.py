@@ -1,0 +1,146 @@
+"""Lens and time effects of image formation, as plain data plus their exact geometry (numpy only).
+
+The renderer's sensor (:mod:`scenegen.render.sensor`) applies these while generating rays; the
+truth never includes blur: it is cast through the pinhole centre (thin lens), at mid-exposure
+(motion blur) or at each row's own time (rolling shutter), for the reference colour channel
+(chromatic aberration). See docs/image_formation.md.
+
+Time: ``tau_s`` is seconds relative to the middle of the frame's exposure. With a rolling shutter
+row v (OpenCV pixel row, 0 = top) is exposed around ``row_time_s(v)``; the middle of the frame,
+``(H - 1) / 2``, is at 0, so the pose in cameras.json is the middle row's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.rotation import matrix_from_rotvec
+
+
+@dataclass(frozen=True, kw_only=True)
+class ThinLens:
+    """Thin-lens defocus about our camera model's rays (distortion and skew kept)."""
+
+    f_number: float  # N = focal length / aperture diameter (unitless)
+    focus_distance_m: float  # depth (along the optical axis, z) of the plane in focus, metres
+    pixel_pitch_um: float  # size of a pixel, micrometres: focal length in metres = fx * pitch
+
+    def aperture_radius_m(self, camera: Camera) -> float:
+        return camera.fx * self.pixel_pitch_um * 1e-6 / (2.0 * self.f_number)
+
+    def blur_radius_px(self, camera: Camera, depth_z_m) -> np.ndarray:
+        """Radius (px) of the circle of confusion of points at ``depth_z_m``: every ray from the
+        aperture through a point at depth Z crosses the focus plane within
+        ``A |1/Z_f - 1/Z| Z_f`` of the chief ray, which projects to ``fx A |1/Z_f - 1/Z|``."""
+        z = np.asarray(depth_z_m, dtype=np.float64)
+        return camera.fx * self.aperture_radius_m(camera) * np.abs(1.0 / self.focus_distance_m - 1.0 / z)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Shutter:
+    exposure_s: float = 0.0  # integration time of the motion blur, seconds (0 = instantaneous)
+    rolling_readout_s: float = 0.0  # top row to bottom row start delay, seconds (0 = global shutter)
+
+    def row_time_s(self, v, height: int):
+        """Time of row ``v`` (px, OpenCV rows) relative to the middle row, seconds."""
+        if height <= 1 or self.rolling_readout_s == 0.0:
+            return 0.0 * np.asarray(v, dtype=np.float64)
+        return self.rolling_readout_s * (np.asarray(v, dtype=np.float64) / (height - 1) - 0.5)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Motion:
+    """Constant velocities. For a camera: in its own frame (OpenCV axes, body velocities); for an
+    object: in the world, about the object's origin."""
+
+    linear_velocity_mps: tuple[float, float, float] = (0.0, 0.0, 0.0)  # metres / second
+    angular_velocity_deg_s: tuple[float, float, float] = (0.0, 0.0, 0.0)  # rotation vector rate, deg / s
+
+    @property
+    def angular_velocity_rad_s(self) -> np.ndarray:
+        return np.radians(np.asarray(self.angular_velocity_deg_s, dtype=np.float64))
+
+    @property
+    def is_static(self) -> bool:
+        return not any(self.linear_velocity_mps) and not any(self.angular_velocity_deg_s)
+
+    def delta(self, tau_s: float) -> Rigid3:
+        """The displacement after ``tau_s`` seconds: rotation exp(omega tau), translation v tau."""
+        R = matrix_from_rotvec(self.angular_velocity_rad_s * tau_s)
+        return Rigid3(R, np.asarray(self.linear_velocity_mps, dtype=np.float64) * tau_s)
+
+
+def cam_from_world_at(cam_from_world_mid: Rigid3, motion: Motion | None, tau_s: float) -> Rigid3:
+    """Camera pose ``tau_s`` seconds after mid-exposure: world_from_cam(tau) = world_from_cam @ delta."""
+    if motion is None or motion.is_static or tau_s == 0.0:
+        return cam_from_world_mid
+    return motion.delta(tau_s).inverse() @ cam_from_world_mid
+
+
+def row_poses(cam_from_world_mid: Rigid3, motion: Motion | None, shutter: Shutter | None,
+              height: int) -> list[Rigid3]:
+    """``cam_from_world`` of every image row (rolling shutter): row v at ``shutter.row_time_s(v)``."""
+    times = np.zeros(height) if shutter is None else shutter.row_time_s(np.arange(height), height)
+    return [cam_from_world_at(cam_from_world_mid, motion, float(t)) for t in times]
+
+
+def world_from_object_at(world_from_object_mid: Rigid3, motion: Motion | None, tau_s: float) -> Rigid3:
+    """Object pose at ``tau_s`` for world-frame velocities about the object's origin."""
+    if motion is None or motion.is_static or tau_s == 0.0:
+        return world_from_object_mid
+    d = motion.delta(tau_s)
+    return Rigid3(d.R @ world_from_object_mid.R, world_from_object_mid.t + d.t)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ChromaticAberration:
+    """Lateral chromatic aberration as per-channel focal scales about the principal point.
+
+    Green is the reference channel: its camera is the spec's camera and all truth is for it.
+    """
+
+    red_focal_scale: float = 1.0  # fx, fy of the red channel = scale * the reference's
+    blue_focal_scale: float = 1.0
+
+    def channel_cameras(self, camera: Camera) -> tuple[Camera, Camera, Camera]:
+        """(red, green, blue) cameras; green is ``camera`` itself."""
+        def scaled(s):
+            return camera if s == 1.0 else replace(camera, fx=camera.fx * s, fy=camera.fy * s, skew=camera.skew * s)
+        return scaled(self.red_focal_scale), camera, scaled(self.blue_focal_scale)
+
+
+REFERENCE_CHANNEL = "G"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Optics:
+    """Everything of a camera beyond its intrinsics that shapes its images (all optional)."""
+
+    lens: ThinLens | None = None
+    shutter: Shutter | None = None
+    chromatic_aberration: ChromaticAberration | None = None
+
+    def to_dict(self) -> dict:
+        out = {}
+        if self.lens is not None:
+            out["lens"] = dict(f_number=self.lens.f_number, focus_distance_m=self.lens.focus_distance_m,
+                               pixel_pitch_um=self.lens.pixel_pitch_um)
+        if self.shutter is not None:
+            out["shutter"] = dict(exposure_s=self.shutter.exposure_s, rolling_readout_s=self.shutter.rolling_readout_s,
+                                  row_time="rolling_readout_s * (v / (H - 1) - 0.5), middle row at 0")
+        if self.chromatic_aberration is not None:
+            ca = self.chromatic_aberration
+            out["chromatic_aberration"] = dict(red_focal_scale=ca.red_focal_scale, blue_focal_scale=ca.blue_focal_scale,
+                                               reference_channel=REFERENCE_CHANNEL)
+        return out
+
+
+def motion_to_dict(motion: Motion | None) -> dict | None:
+    if motion is None:
+        return None
+    return {"linear_velocity_mps": list(motion.linear_velocity_mps),
+            "angular_velocity_deg_s": list(motion.angular_velocity_deg_s)}
+

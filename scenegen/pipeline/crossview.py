@@ -1,0 +1,168 @@
+"""The cross-view stage of the pipeline: runs after every view is rendered, writes the cross-view
+truth (docs/crossview.md) through the dataset writer (atomic, hashed in the manifest).
+
+Only views that are complete in the dataset take part (a ``--frames`` run covers the pairs it
+has). Each view's truth points are recomputed in float64 by the truth pass (one ray cast per
+pixel, milliseconds; the same call as the stored truth), so resumed runs give the same bytes.
+Views are projected into each other with their mid-exposure poses (the scene is at
+mid-exposure, as for the truth): for a moving camera with a rolling shutter, i's points follow
+its per-row poses but j is projected as a global shutter at its mid-exposure pose.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from scenegen.crossview.correspondence import correspond, flow_field
+from scenegen.crossview.matches import MatchParams, label_real_matches, sift_matches, synthetic_matches
+from scenegen.crossview.targets import board_view_truth
+from scenegen.dataset.codecs import encode_exr, encode_flo, encode_json, encode_npy, read_png
+from scenegen.dataset.crossview import (INDEX_FORMAT, INDEX_FORMAT_VERSION, INLIER, LABELS, MATCH_COLUMNS,
+                                        OCCLUSION_REL_TOL,
+                                        STATE_NAMES, TWOVIEW_PIXELS, VISIBLE, Correspondence,
+                                        encode_correspondence_channels)
+from scenegen.dataset.layout import (CROSSVIEW_INDEX, correspondence_path, flow_path, matches_path, twoview_path,
+                                     view_paths, view_targets_path)
+from scenegen.geometry.seeds import hashed_seed32
+from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
+from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
+from scenegen.pipeline.stereo import write_stereo_frame
+from scenegen.pipeline.view import view_truth
+
+#: Spec geometry kinds that are planes in their object's z = 0 plane (normal +z): they get a
+#: homography per pair.
+PLANAR_KINDS = ("plane", "checkerboard", "charuco", "aruco_grid")
+
+
+@dataclass(frozen=True)
+class CrossviewSummary:
+    pairs: int
+    flows: int
+    stereo_frames: int
+    files: int
+
+
+class _Context:
+    """What the stage's writers share: the complete views, the loaded scene, cached truth points
+    and correspondences, and the files written."""
+
+    def __init__(self, spec, views, built, writer):
+        self.spec, self.built, self.writer = spec, built, writer
+        self.views = {v.name: v for v in views}
+        self._points: dict = {}
+        self._corr: dict = {}
+        self.files: list[str] = []
+
+    def camera(self, name):
+        v = self.views[name]
+        return self.built.cameras[v.camera], v.cam_from_world
+
+    def points(self, name) -> np.ndarray:
+        """(H, W, 3) float64 world truth points of a view (NaN = no surface)."""
+        if name not in self._points:
+            t = view_truth(self.built, self.views[name])  # the same call as the view's stored truth
+            self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
+        return self._points[name]
+
+    def corr(self, i, j) -> Correspondence:
+        if (i, j) not in self._corr:
+            cam_j, pose_j = self.camera(j)
+            self._corr[(i, j)] = correspond(self.points(i), cam_j, pose_j, self.built.visible_from)
+        return self._corr[(i, j)]
+
+    def write(self, rel: str, data: bytes) -> None:
+        self.writer.write_file(rel, data)
+        self.files.append(rel)
+
+
+def _homographies(ctx: _Context, i: str, j: str) -> dict:
+    """Plane homographies (undistorted pixels i -> j) of every planar object: planes and boards."""
+    cam_i, pose_i = ctx.camera(i)
+    cam_j, pose_j = ctx.camera(j)
+    rel = pose_j @ pose_i.inverse()
+    out = {}
+    for obj in ctx.spec.objects:
+        if obj.geometry.kind not in PLANAR_KINDS:
+            continue
+        wfo = obj.transform.world_from_object
+        n_i, d_i = plane_in_camera(pose_i, wfo.R[:, 2], wfo.t)  # object z = 0 plane, normal +z
+        if abs(d_i) < 1e-12:
+            continue  # camera i lies in the plane: no homography
+        H = plane_homography(cam_i.K, cam_j.K, rel, n_i, d_i)
+        out[obj.name] = {"H": H.tolist(), "plane_normal_i": n_i.tolist(), "plane_distance_i_m": d_i}
+    return out
+
+
+def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
+    """Correspondences both ways, two-view geometry and match sets of one pair; its index entry."""
+    entry = {"i": a, "j": b}
+    for i, j in ((a, b), (b, a)):
+        ctx.write(correspondence_path(i, j), encode_exr(encode_correspondence_channels(ctx.corr(i, j))))
+    cam_a, pose_a = ctx.camera(a)
+    cam_b, pose_b = ctx.camera(b)
+    tv = TwoView.of(cam_a, pose_a, cam_b, pose_b).to_dict()
+    tv.update({"i": a, "j": b, "homographies": _homographies(ctx, a, b), "pixels": TWOVIEW_PIXELS})
+    ctx.write(twoview_path(a, b), encode_json(tv))
+    if cfg.matches is not None:
+        ms = cfg.matches
+        p = MatchParams(count=ms.count, sigma_px=ms.sigma_px, outlier_fraction=ms.outlier_fraction,
+                        near_miss_fraction=ms.near_miss_fraction, near_miss_px=tuple(ms.near_miss_px),
+                        seed=hashed_seed32(ms.seed, a, b))
+        c = ctx.corr(a, b)
+        rows = synthetic_matches(c.uv, c.visible, cam_b.width, cam_b.height, p)
+        ctx.write(matches_path(a, b, "synthetic"), encode_npy(rows))
+        entry["synthetic_matches"] = {"count": len(rows), "seed": p.seed}
+    if cfg.sift:
+        root = ctx.writer.root
+        pi, pj = sift_matches(read_png(root / view_paths(a)["image"]), read_png(root / view_paths(b)["image"]),
+                              cfg.sift_ratio)
+        P = ctx.built.surface_points(cam_a, pose_a, pi)
+        c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
+        rows = label_real_matches(pi, pj, c.uv.reshape(-1, 2), c.state.ravel() == VISIBLE, cfg.sift_inlier_px)
+        ctx.write(matches_path(a, b, "sift"), encode_npy(rows))
+        entry["sift_matches"] = {"count": len(rows), "inliers": int((rows[:, MATCH_COLUMNS.index("label")] == INLIER).sum()),
+                                 "ratio": cfg.sift_ratio, "inlier_px": cfg.sift_inlier_px}
+    return entry
+
+
+def run_crossview(spec, views, built, writer, *, spp: int, seed: int) -> CrossviewSummary | None:
+    """Write the cross-view truth ``spec.crossview`` asks for (nothing when it is None).
+
+    ``views``: the resolved views; ``built``: the loaded scene (:class:`scenegen.render.scene.LoadedScene`);
+    ``writer``: the open DatasetWriter; ``spp``, ``seed``: render settings (rectified renders).
+    """
+    cfg = getattr(spec, "crossview", None)
+    if cfg is None:
+        return None
+    done = [v for v in views if writer.is_complete(v.name)]
+    ctx = _Context(spec, done, built, writer)
+    names = set(ctx.views)
+    pairs = [p for p in select_pairs(cfg.pairs, views) if p[0] in names and p[1] in names]
+    index = {"format": INDEX_FORMAT, "format_version": INDEX_FORMAT_VERSION,
+             "occlusion_rel_tol": OCCLUSION_REL_TOL,
+             "state_codes": {str(k): v for k, v in STATE_NAMES.items()},
+             "match_columns": list(MATCH_COLUMNS), "match_labels": {str(k): v for k, v in LABELS.items()},
+             "pairs": [_pair(ctx, cfg, a, b) for a, b in pairs], "flow": [], "stereo": [], "targets": []}
+    if cfg.flow:  # adjacent frames of the full stream, both complete: stable across --frames runs
+        for vs in streams(views).values():
+            for va, vb in zip(vs, vs[1:]):
+                if va.name not in names or vb.name not in names:
+                    continue
+                for i, j in ((va.name, vb.name), (vb.name, va.name)):
+                    ctx.write(flow_path(i, j), encode_flo(flow_field(ctx.corr(i, j))))
+                index["flow"].append({"i": va.name, "j": vb.name})
+    if cfg.stereo:
+        for left, right in stereo_frames(done, spec.rigs):
+            index["stereo"].append(write_stereo_frame(ctx, left, right, spp=spp, seed=seed))
+    if cfg.targets and built.boards:
+        for v in done:
+            cam, pose = ctx.camera(v.name)
+            boards = {name: board_view_truth(board, wfb, cam, pose, built.visible_from)
+                      for name, (board, wfb) in built.boards.items()}
+            ctx.write(view_targets_path(v.name), encode_json({"view": v.name, "boards": boards}))
+            index["targets"].append(v.name)
+    index["files"] = sorted(ctx.files)
+    if len(done) == len(views):  # the index describes the whole run; partial runs write none
+        writer.write_file(CROSSVIEW_INDEX, encode_json(index))
+    return CrossviewSummary(len(index["pairs"]), len(index["flow"]), len(index["stereo"]), len(ctx.files) + 1)

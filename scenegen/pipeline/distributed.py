@@ -1,0 +1,136 @@
+"""Rendering on Dask distributed workers: one task per frame, a loaded scene kept per worker.
+
+The client (the process owning the :class:`~scenegen.dataset.writer.DatasetWriter`) submits one task
+per frame (a rig's members share a frame) of one scene; a worker builds the scene the first time
+it sees ``(spec, variant, spp, Mitsuba variant)`` and keeps it (:data:`_SCENES`, the last
+:data:`SCENES_KEPT` scenes), renders the frame's views, writes their files with
+:func:`scenegen.dataset.writer.write_view_files` and returns the hashes. The client records each
+view with :meth:`~scenegen.dataset.writer.DatasetWriter.record_views` in the run's order (every frame
+already done at once: one manifest rewrite, whose cost grows with the run), so the manifest is
+byte-identical to a serial run's, and a run killed at any point resumes like a serial one.
+
+Workers must see the output folder at the same path (one machine, or a shared file system).
+Mitsuba is imported in a worker only through :func:`scenegen.render.load_scene`, which points
+Dr.Jit at a good libLLVM before ``import drjit``.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections import OrderedDict
+from pathlib import Path
+
+from scenegen.dataset.writer import write_view_files
+from scenegen.pipeline.view import render_view_data
+from scenegen.render import configure_llvm, load_scene
+from scenegen.spec import resolve_views
+
+__all__ = ["open_client", "render_views_dask", "render_frame_task", "worker_stats", "SCENES_KEPT"]
+
+#: Loaded scenes a worker keeps (least recently used dropped first).
+SCENES_KEPT = 2
+_SCENES: "OrderedDict[tuple, tuple]" = OrderedDict()  # key -> (spec, views, built)
+_STATS = {"scene_loads": 0, "views_rendered": 0}
+
+
+@contextlib.contextmanager
+def open_client(*, workers: int | None = None, scheduler: str | None = None):
+    """A ``distributed.Client``: on a new LocalCluster of ``workers`` processes (one thread each),
+    or connected to ``scheduler`` (e.g. ``tcp://host:8786``). Closed (and the cluster shut down)
+    on exit."""
+    if (workers is None) == (scheduler is None):
+        raise ValueError("give exactly one of --workers N and --scheduler ADDRESS")
+    try:
+        # Dask on use: a heavy dependency (~1 s to import) that only --workers/--scheduler need
+        from distributed import Client, LocalCluster
+    except ImportError:  # fail only when the feature is used
+        raise ValueError("--workers/--scheduler need Dask distributed: pip install 'dask[distributed]'") from None
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError) as e:
+            raise ValueError(f"--scheduler {scheduler}: cannot connect ({e})") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    if workers < 1:
+        raise ValueError(f"--workers must be at least 1, got {workers}")
+    configure_llvm()  # spawned workers inherit DRJIT_LIBLLVM_PATH through the environment
+    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+def _worker_scene(source, spp: int, variant: str):
+    """(spec, views, built) for ``source``, loaded once per worker and kept."""
+    key = (source.key, int(spp), variant)
+    hit = _SCENES.get(key)
+    if hit is not None:
+        _SCENES.move_to_end(key)
+        return hit
+    spec = source.load()
+    built = load_scene(spec, variant=variant, spp=spp)  # libLLVM path, then Mitsuba, the variant
+    _SCENES[key] = (spec, resolve_views(spec), built)
+    _STATS["scene_loads"] += 1
+    while len(_SCENES) > SCENES_KEPT:
+        _SCENES.popitem(last=False)
+    return _SCENES[key]
+
+
+def render_frame_task(source, out_dir: str, items, spp: int, seed: int, variant: str):
+    """Worker task: render and write the views ``items`` = [(index in the run, view name)];
+    returns [(view name, {relative path: sha256})]."""
+    spec, views, built = _worker_scene(source, spp, variant)
+    out = []
+    for index, name in items:
+        v = views[index]
+        if v.name != name:  # the worker's spec is not the client's: never write a wrong view
+            raise RuntimeError(f"worker resolved view {index} as {v.name!r}, the client as {name!r}")
+        image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
+        out.append((name, write_view_files(out_dir, name, image=image, linear_rgb=linear, truth=truth,
+                                              extra_files=extra)))
+        del image, linear, truth, extra  # release the frame's buffers before the next
+        _STATS["views_rendered"] += 1
+    return out
+
+
+def worker_stats() -> dict:
+    """This process's counters: scene_loads, views_rendered, pid (run it with ``client.run``)."""
+    return {**_STATS, "pid": os.getpid()}
+
+
+def render_views_dask(client, source, writer, pending, *, spp: int, seed: int, variant: str,
+                      on_done=None) -> int:
+    """Render ``pending`` = [(index, View)] on the client's workers, one task per frame; record
+    each view in ``writer`` in the given order. Returns the number of views rendered."""
+    frames: "OrderedDict[int, list]" = OrderedDict()
+    for index, v in pending:
+        frames.setdefault(v.frame_index, []).append((index, v.name))
+    out_dir = str(Path(writer.root).resolve())
+    futures = [client.submit(render_frame_task, source, out_dir, items, spp, seed, variant, pure=False)
+               for items in frames.values()]
+    n, k = 0, 0
+    try:
+        while k < len(futures):  # in the run's order: the manifest grows as in a serial run
+            batch = dict(futures[k].result())  # wait for the next frame, then take every
+            k += 1                              # following one already done: one manifest rewrite
+            while k < len(futures) and futures[k].done():
+                batch.update(futures[k].result())
+                k += 1
+            writer.record_views(batch)
+            n += len(batch)
+            for _ in batch:
+                if on_done is not None:
+                    on_done()
+    finally:
+        for fut in futures:
+            fut.cancel()
+    return n

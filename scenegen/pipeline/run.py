@@ -1,0 +1,136 @@
+"""The main job: a scene spec -> Mitsuba renders + exact per-pixel truth -> a dataset on disk."""
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from scenegen.assets.targets import target_truth
+from scenegen.dataset.cameras import ViewCamera
+from scenegen.dataset.codecs import encode_json
+from scenegen.dataset.layout import target_path
+from scenegen.dataset.writer import DatasetWriter, software_versions
+from scenegen.imaging.stage import imaging_record
+from scenegen.pipeline.crossview import run_crossview
+from scenegen.pipeline.distributed import render_views_dask
+from scenegen.pipeline.progress import FrameProgress
+from scenegen.pipeline.view import render_view_data, view_optics
+from scenegen.render import load_scene
+from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
+from scenegen.spec.model import effective_spp
+from scenegen.spec.variants import SpecSource
+from scenegen.spec.views import light_scales_dict
+
+
+@dataclass(frozen=True)
+class RenderSettingsUsed:
+    spp: int  # asked for (spec or --spp)
+    spp_effective: int  # what the sampler takes per pixel (Mitsuba rounds some counts up)
+    seed: int
+    variant: str  # the resolved Mitsuba variant
+    sampler: str
+    max_depth: int
+    bit_depth: int
+
+
+@dataclass(frozen=True)
+class RenderSummary:
+    out_dir: Path
+    views_total: int
+    views_rendered: int
+    views_skipped: int  # already complete (resume)
+    seconds: float
+    settings: RenderSettingsUsed
+
+
+def parse_frames(text: str | None, n_frames: int) -> set[int] | None:
+    """``'0-9,12'`` -> {0..9, 12} (frame indices, inclusive ranges); None = all frames."""
+    if text is None:
+        return None
+    out: set[int] = set()
+    for part in text.split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+        if not m:
+            raise ValueError(f"--frames: expected indices or ranges like '0-9,12', got {part!r}")
+        a = int(m.group(1))
+        b = int(m.group(2)) if m.group(2) is not None else a
+        if b < a or b >= n_frames:
+            raise ValueError(f"--frames: range {part.strip()!r} is outside 0..{n_frames - 1}")
+        out.update(range(a, b + 1))
+    return out
+
+
+def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | None = None,
+                seed: int | None = None, variant: str | None = None, resume: bool = False,
+                progress: bool = True, dask_client=None) -> RenderSummary:
+    """Render every selected view of a spec into ``out_dir`` (see docs/dataset_format.md).
+
+    ``spec_path``: a spec file, or a :class:`scenegen.spec.variants.SpecSource` (e.g. a variant).
+    ``dask_client``: a ``distributed.Client``; its workers render and write the views, this
+    process records them in the run's order (scenegen/pipeline/distributed.py); None = render here.
+
+    Raises :class:`scenegen.errors.SpecError` for a bad spec, ``ValueError`` for bad options,
+    :class:`scenegen.dataset.errors.DatasetError` for an unusable output directory.
+    """
+    source = spec_path if isinstance(spec_path, SpecSource) else None
+    spec = source.load() if source is not None else load_spec(spec_path)
+    views = resolve_views(spec)
+    n_frames = 1 + max((v.frame_index for v in views), default=-1)
+    wanted = parse_frames(frames, n_frames)
+    rs = spec.render
+    spp = rs.spp if spp is None else int(spp)
+    seed = rs.seed if seed is None else int(seed)
+    if spp <= 0:
+        raise ValueError(f"--spp must be positive, got {spp}")
+
+    t0 = time.perf_counter()
+    built = load_scene(spec, variant=variant or rs.variant, spp=spp)
+    used = RenderSettingsUsed(spp=spp, spp_effective=effective_spp(rs.sampler, spp), seed=seed,
+                              variant=built.variant, sampler=rs.sampler, max_depth=rs.max_depth,
+                              bit_depth=rs.bit_depth)
+    # The run's identity: the spec plus every override that changes output bytes.
+    run_hash = hashlib.sha256((spec_sha256(spec) + json.dumps(used.__dict__, sort_keys=True)).encode()).hexdigest()
+    writer = DatasetWriter(out_dir, spec_sha256=run_hash, seed=seed, variant=used.variant,
+                           versions=software_versions(), resume=resume)
+    view_cams = {v.name: ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
+                                       camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
+                                       frame_index=v.frame_index, optics=view_optics(built, v),
+                                       view_set=spec.view_sets[v.view_set].prefix,
+                                       lights=light_scales_dict(spec, v.light_scales))
+                 for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
+    resolved = spec_to_dict(spec)
+    resolved["render_used"] = dict(used.__dict__)
+    resolved["objects_ids"] = built.objects
+    if (imaging := imaging_record(spec, views)) is not None:
+        resolved["imaging_used"] = imaging
+    writer.write_cameras(view_cams, resolved)
+    for name, mesh in built.meshes_world.items():
+        writer.write_mesh(name, mesh)
+    for name, (board, world_from_board) in built.boards.items():
+        writer.write_file(target_path(name), encode_json(target_truth(board, world_from_board)))
+
+    todo = [(i, v) for i, v in enumerate(views) if wanted is None or v.frame_index in wanted]
+    skipped = sum(writer.is_complete(v.name) for _, v in todo)
+    rendered = 0
+    with FrameProgress(progress, len(todo)) as bar:
+        if dask_client is not None:  # workers render and write; recorded here in the run's order
+            for _ in range(skipped):
+                bar.advance()
+            pending = [(index, v) for index, v in todo if not writer.is_complete(v.name)]
+            rendered = render_views_dask(
+                dask_client, source or SpecSource.from_path(spec_path), writer, pending, spp=spp,
+                seed=seed, variant=used.variant, on_done=bar.advance)
+        for index, v in todo if dask_client is None else ():
+            if writer.is_complete(v.name):
+                bar.advance()
+                continue
+            image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
+            writer.write_view(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra)
+            rendered += 1
+            bar.advance()
+    run_crossview(spec, views, built, writer, spp=spp, seed=seed)  # cross-view truth (docs/crossview.md)
+    writer.close()
+    return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)

@@ -1,0 +1,57 @@
+"""The rectified stereo frames of the cross-view stage: both sides rendered as the same ideal
+pinhole (no resampling), exact disparity from their truth, correspondences with visibility,
+KITTI PNGs, rectification maps and calib.json (docs/crossview.md, "Rectified stereo").
+
+Rectified views are ideal pinholes: no lens blur, motion or chromatic aberration, the clean
+sRGB encoding, both sides under the left view's lighting (its view set's ``lights``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen.crossview.correspondence import correspond
+from scenegen.dataset.codecs import encode_exr, encode_json, encode_kitti_disparity, encode_pfm, encode_png, pack_channels
+from scenegen.dataset.crossview import VISIBLE, encode_correspondence_channels
+from scenegen.dataset.layout import STEREO_SIDES, stereo_dir, stereo_path
+from scenegen.dataset.truth import LINEAR_CHANNELS
+from scenegen.geometry.color import srgb_image
+from scenegen.geometry.rectify import disparity_from_depth, rectification_map, rectify
+from scenegen.geometry.seeds import hashed_seed32
+from scenegen.geometry.twoview import TwoView
+
+
+def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> dict:
+    """Write one rectified frame through ``ctx`` (the stage's context); returns its index entry."""
+    cam_l, pose_l = ctx.camera(left)
+    cam_r, pose_r = ctx.camera(right)
+    rect = rectify(cam_l, pose_l, cam_r, pose_r)
+    rc = rect.camera
+    built = ctx.built
+    view_l = ctx.views[left]
+    truths = {}
+    for side, pose in zip(STEREO_SIDES, (rect.cam_left_from_world, rect.cam_right_from_world)):
+        lin = built.render_ideal(view_l.camera, rc, pose, spp=spp, seed=hashed_seed32(seed, left, side),
+                                 light_scales=view_l.light_scales)  # both sides: the left view's lighting
+        ctx.write(stereo_path(left, "image", side), encode_png(srgb_image(lin, ctx.spec.render.bit_depth)))
+        ctx.write(stereo_path(left, "linear", side), encode_exr(pack_channels("", lin, LINEAR_CHANNELS)))
+        t = built.truth(rc, pose)
+        truths[side] = (np.where(t["valid"][..., None], t["points_world"], np.nan), t["depth_z"])
+    for side, other_pose in zip(STEREO_SIDES, (rect.cam_right_from_world, rect.cam_left_from_world)):
+        pts, depth = truths[side]
+        d = disparity_from_depth(depth, rect.f, rect.baseline_m)
+        c = correspond(pts, rc, other_pose, built.visible_from)
+        ctx.write(stereo_path(left, "disparity_pfm", side), encode_pfm(d))
+        ctx.write(stereo_path(left, "disparity_occ", side), encode_kitti_disparity(d, np.isfinite(d)))
+        ctx.write(stereo_path(left, "disparity_noc", side), encode_kitti_disparity(d, c.state == VISIBLE))
+        ctx.write(stereo_path(left, "correspondence", side), encode_exr(encode_correspondence_channels(c)))
+    for side, raw, R in zip(STEREO_SIDES, (cam_l, cam_r), (rect.R1, rect.R2)):
+        mp = rectification_map(raw, R, rc)
+        ctx.write(stereo_path(left, "map", side), encode_exr(
+            {"map_x": mp[..., 0].astype(np.float32), "map_y": mp[..., 1].astype(np.float32)}))
+    calib = rect.to_dict()
+    calib.update({"left_view": left, "right_view": right,
+                  "raw_left": {"camera": cam_l.to_dict(), "cam_from_world": pose_l.to_dict()},
+                  "raw_right": {"camera": cam_r.to_dict(), "cam_from_world": pose_r.to_dict()},
+                  "twoview_raw": TwoView.of(cam_l, pose_l, cam_r, pose_r).to_dict()})
+    ctx.write(stereo_path(left, "calib"), encode_json(calib))
+    return {"left_view": left, "right_view": right, "dir": stereo_dir(left)}

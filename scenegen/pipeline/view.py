@@ -1,0 +1,64 @@
+"""One view of a run: render it, cast its truth, run the camera's imaging chain.
+
+The same function serves the serial run (:mod:`.run`), the Dask workers (:mod:`.distributed`) and
+the cross-view stage (which recasts truth points with :func:`view_truth`), so a view's bytes do
+not depend on where it was made.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen.geometry.color import srgb_image
+from scenegen.geometry.optics import motion_to_dict, row_poses
+from scenegen.geometry.seeds import hashed_seed32
+from scenegen.imaging.stage import apply_imaging
+
+
+def view_seed(seed: int, view_index: int) -> int:
+    """Sampler seed of one view: distinct per view, fixed by (seed, index in the run) (uint32)."""
+    return hashed_seed32(seed, view_index)
+
+
+def rolling_shutter_rows(built, view):
+    """Per-row ``cam_from_world`` for a moving camera with a rolling shutter, else None."""
+    shutter = getattr(built.optics.get(view.camera), "shutter", None)
+    if shutter is None or shutter.rolling_readout_s == 0 or view.motion is None or view.motion.is_static:
+        return None
+    return row_poses(view.cam_from_world, view.motion, shutter, built.cameras[view.camera].height)
+
+
+def view_truth(built, view) -> dict[str, np.ndarray]:
+    """The truth pass of a view as the dataset stores it: per-row poses for a rolling shutter;
+    range and depth_z in float64 (rounded to float32 when written)."""
+    return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view))
+
+
+def _truth_for_storage(truth: dict) -> dict:
+    return {k: v.astype(np.float32) if v.dtype == np.float64 else v for k, v in truth.items()}
+
+
+def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
+    """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
+    :func:`scenegen.dataset.writer.encode_view`; ``index`` is the view's position in the run."""
+    linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
+                          light_scales=v.light_scales)
+    truth = view_truth(built, v)
+    params = spec.cameras[v.camera].imaging
+    if params is None:  # clean path: sRGB encoding of the linear render
+        image, extra = srgb_image(linear, spec.render.bit_depth), None
+    else:  # the camera's photometric chain; its vignetting map is saved as truth
+        image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name)
+    return image, linear, _truth_for_storage(truth), extra
+
+
+def view_optics(built, view) -> dict | None:
+    """What cameras.json records of a view's lens and time effects (None if it has none)."""
+    optics = built.optics.get(view.camera)
+    d = optics.to_dict() if optics is not None else {}
+    if view.motion is not None and not view.motion.is_static:
+        d["camera_motion"] = {**motion_to_dict(view.motion), "frame": "camera (OpenCV axes), body velocities; "
+                              "world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau], tau from mid-exposure"}
+    ca = getattr(optics, "chromatic_aberration", None)
+    if ca is not None:
+        d["channel_cameras"] = {c: cam.to_dict() for c, cam in zip("RGB", ca.channel_cameras(built.cameras[view.camera]))}
+    return d or None

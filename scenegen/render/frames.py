@@ -1,0 +1,59 @@
+"""Rendering images of a loaded scene: a view with its camera's lens and time effects, and the
+ideal rectified renders of a stereo pair. Linear float32 RGB out; encoding is the pipeline's."""
+from __future__ import annotations
+
+import mitsuba as mi
+import numpy as np
+
+from scenegen.geometry.pose import Rigid3
+from scenegen.render.lights import set_lighting
+from scenegen.render.objects import place_moving_objects
+
+
+def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int,
+                motion=None, light_scales=None) -> np.ndarray:
+    """Linear float32 (H, W, 3) radiance of one view, with the camera's lens and time effects.
+
+    ``cam_from_world`` is the mid-exposure pose; ``motion`` the camera's own velocities;
+    ``light_scales`` the factor on each spec light's power (:func:`set_lighting`; None = every
+    light at its spec power, whatever an earlier view used). Moving objects are rendered in
+    ``built.motion_subframes`` sub-frames (each a slice of the shutter interval, with
+    spp / sub-frames samples) and averaged; they are left at mid-exposure, where the truth is
+    cast. Chromatic aberration renders each colour channel with its own camera.
+    """
+    set_lighting(built, light_scales)
+    camera = built.cameras[camera_name]
+    optics = built.optics.get(camera_name)
+    sensor = built.sensors[camera_name]
+    ca = getattr(optics, "chromatic_aberration", None)
+    channel_cameras = ca.channel_cameras(camera) if ca is not None else (camera,)
+    shutter = getattr(optics, "shutter", None)
+    exposure = 0.0 if shutter is None else shutter.exposure_s
+    n_sub = built.motion_subframes if exposure > 0 else 1
+    sub_spp = max(1, int(spp) // n_sub)
+    out = np.zeros((camera.height, camera.width, 3), np.float64)
+    for k in range(n_sub):
+        if n_sub > 1:
+            place_moving_objects(built, ((k + 0.5) / n_sub - 0.5) * exposure)
+        for c, cam in enumerate(channel_cameras):
+            sensor.set_camera(cam, cam_from_world, optics, motion, time_window=(k / n_sub, (k + 1) / n_sub))
+            img = np.array(mi.render(built.scene, sensor=sensor, spp=sub_spp, seed=(int(seed) + k) % 2**32),
+                           dtype=np.float32)[..., :3]
+            if len(channel_cameras) == 3:
+                out[..., c] += img[..., c]
+            else:
+                out += img
+    if n_sub > 1:
+        place_moving_objects(built, 0.0)
+    return (out / n_sub).astype(np.float32)
+
+
+def render_ideal(built, sensor_camera_name: str, camera, cam_from_world: Rigid3, *, spp: int, seed: int,
+                 light_scales=None) -> np.ndarray:
+    """Linear float32 (H, W, 3) of ``camera`` (a pinhole of the sensor's size, e.g. a rectified
+    view) through the sensor of ``sensor_camera_name``: no lens, motion or aberration."""
+    set_lighting(built, light_scales)
+    sensor = built.sensors[sensor_camera_name]
+    sensor.set_camera(camera, cam_from_world)
+    img = mi.render(built.scene, sensor=sensor, spp=int(spp), seed=int(seed))
+    return np.array(img, dtype=np.float32)[..., :3]
