@@ -18,7 +18,7 @@ from scenegen.geometry import seeds
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.geometry.rotation import rotation_from_euler_deg
 from scenegen.spec import model as m
-from scenegen.spec._yaml import Document, Fields, Node, suggest
+from scenegen.located_yaml import Document, Fields, Node, suggest
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
                   "cameras", "rigs", "views", "crossview", "variation")

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from scenegen.errors import Where
 from scenegen.spec import model as m
-from scenegen.spec._yaml import Node, suggest
+from scenegen.located_yaml import Node, suggest
 
 _WHERE = dict(default=None, compare=False, repr=False)
 _SEED_MAX = 2**32 - 1
