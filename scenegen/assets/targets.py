@@ -417,19 +417,3 @@ def board_from_spec(target) -> Board:
             last = e
     raise ValueError(f"{kind} target: no picture resolution puts every length on whole pixels "
                      f"({last}); use lengths that are multiples of a common step")
-
-
-def target_truth(board, world_from_board) -> dict:
-    """A calibration target's exact points, board frame and world frame (metres): the content of
-    the dataset's ``scene/targets/<object>.json``."""
-    pts = np.asarray(board.points_board, dtype=np.float64)
-    d = {"kind": board.kind, "size_m": list(map(float, board.size_m)),
-         "world_from_board": world_from_board.to_dict(),
-         "point_ids": np.asarray(board.point_ids).tolist(),
-         "points_board": pts.tolist(), "points_world": world_from_board.apply(pts).tolist(),
-         "frame": "board: origin at the top-left physical corner, x along the picture's columns,"
-                  " y along its rows, z = 0 on the surface"}
-    for extra in ("marker_ids", "marker_corners_board"):
-        if getattr(board, extra, None) is not None:
-            d[extra] = np.asarray(getattr(board, extra)).tolist()
-    return d

@@ -25,6 +25,7 @@ from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIB
 from scenegen.geometry.conventions import in_image
 from scenegen.geometry.pose import Rigid3
 
+
 def project_points(points_world, camera, cam_from_world: Rigid3):
     """((N, 2) pixels, (N,) z in the camera frame, (N,) valid projection) of world points (N, 3)."""
     P_cam = cam_from_world.apply(np.asarray(points_world, np.float64))

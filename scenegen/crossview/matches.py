@@ -16,10 +16,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from scenegen.dataset.crossview import INLIER, MATCH_COLUMNS, NEAR_MISS_OUTLIER, NO_TRUTH, UNIFORM_OUTLIER, WRONG
 from scenegen.geometry.color import to_grey8
+
 
 @dataclass(frozen=True, kw_only=True)
 class MatchParams:
@@ -67,8 +69,6 @@ def synthetic_matches(uv_j, visible, width_j: int, height_j: int, p: MatchParams
 def sift_matches(image_i, image_j, ratio: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
     """SIFT (OpenCV, default parameters) keypoints matched with Lowe's ratio test ``ratio``
     (brute force, L2): ((N, 2) points of i, (N, 2) points of j), OpenCV pixels."""
-    import cv2
-
     sift = cv2.SIFT_create()
     kp_i, des_i = sift.detectAndCompute(to_grey8(image_i), None)
     kp_j, des_j = sift.detectAndCompute(to_grey8(image_j), None)

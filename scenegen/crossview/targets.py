@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from scenegen.crossview.correspondence import project_points
 from scenegen.dataset.crossview import OCCLUDED, OUT_OF_FRAME, VISIBLE
 from scenegen.geometry.conventions import in_image
-from scenegen.crossview.correspondence import project_points
 
 
 def board_view_truth(board, world_from_board, camera, cam_from_world, visible_fn) -> dict:

@@ -124,7 +124,8 @@ class MatchSet:
         return len(self.rows)
 
     def __repr__(self) -> str:
-        return f"MatchSet({self.i!r} -> {self.j!r}, {self.kind}, {len(self)} matches, {int(self.inliers.sum())} inliers)"
+        n_in = int(self.inliers.sum())
+        return f"MatchSet({self.i!r} -> {self.j!r}, {self.kind}, {len(self)} matches, {n_in} inliers)"
 
 
 def check_match_rows(rows) -> np.ndarray:

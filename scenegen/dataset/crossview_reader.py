@@ -17,11 +17,24 @@ from scenegen.dataset.codecs.kitti import decode_kitti_disparity
 from scenegen.dataset.codecs.npy import read_npy
 from scenegen.dataset.codecs.pfm import read_pfm
 from scenegen.dataset.codecs.png import read_png
-from scenegen.dataset.crossview import (CrossviewIndex, Correspondence, MatchSet, check_match_rows,
-                                        decode_correspondence_channels)
+from scenegen.dataset.crossview import (
+    Correspondence,
+    CrossviewIndex,
+    MatchSet,
+    check_match_rows,
+    decode_correspondence_channels,
+)
 from scenegen.dataset.errors import DatasetError
-from scenegen.dataset.layout import (CROSSVIEW_INDEX, STEREO_SIDES, correspondence_path, flow_path, matches_path,
-                                     stereo_path, twoview_path, view_targets_path)
+from scenegen.dataset.layout import (
+    CROSSVIEW_INDEX,
+    STEREO_SIDES,
+    correspondence_path,
+    flow_path,
+    matches_path,
+    stereo_path,
+    twoview_path,
+    view_targets_path,
+)
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
 

@@ -97,3 +97,11 @@ def sha256_file(path) -> str:
         while chunk := f.read(_HASH_CHUNK):
             h.update(chunk)
     return h.hexdigest()
+
+
+def read_decoded(path, decode):
+    """``decode(bytes of path)``; a ValueError of the decoder names the file."""
+    try:
+        return decode(Path(path).read_bytes())
+    except ValueError as e:
+        raise ValueError(f"{path}: {e}") from None

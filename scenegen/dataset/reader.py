@@ -24,8 +24,18 @@ from scenegen.dataset.codecs.ply import read_ply
 from scenegen.dataset.codecs.png import read_png
 from scenegen.dataset.crossview_reader import CrossviewTruth
 from scenegen.dataset.errors import DatasetError
-from scenegen.dataset.layout import (CAMERAS, MESHES_DIR, TARGETS_DIR, check_rel_path, mesh_path, names_under,
-                                     target_path, view_paths, vignetting_path, VIGNETTING_CHANNEL)
+from scenegen.dataset.layout import (
+    CAMERAS,
+    MESHES_DIR,
+    TARGETS_DIR,
+    VIGNETTING_CHANNEL,
+    check_rel_path,
+    mesh_path,
+    names_under,
+    target_path,
+    view_paths,
+    vignetting_path,
+)
 from scenegen.dataset.manifest import STATUS_COMPLETE, load_manifest
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
 from scenegen.geometry.camera import Camera

@@ -25,8 +25,15 @@ from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
 from scenegen.dataset.files import atomic_write_bytes, remove_stale_temp_files, sha256_bytes
 from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, check_view_name, mesh_path, view_paths
-from scenegen.dataset.manifest import (FORMAT, FORMAT_VERSION, IDENTITY_KEYS, STATUS_COMPLETE, STATUS_PENDING,
-                                       load_manifest, manifest_bytes)
+from scenegen.dataset.manifest import (
+    FORMAT,
+    FORMAT_VERSION,
+    IDENTITY_KEYS,
+    STATUS_COMPLETE,
+    STATUS_PENDING,
+    load_manifest,
+    manifest_bytes,
+)
 from scenegen.dataset.truth import LINEAR_CHANNELS, encode_truth
 
 

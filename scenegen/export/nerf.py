@@ -19,6 +19,7 @@ import numpy as np
 from scenegen.dataset.layout import view_paths
 from scenegen.export.common import write
 from scenegen.export.errors import ExportError
+from scenegen.geometry.camera import camera_model
 from scenegen.geometry.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
 
 
@@ -28,9 +29,9 @@ def intrinsics(cam) -> dict:
     if cam.skew != 0:
         raise ExportError("NeRF transforms.json has no skew; a camera has skew != 0")
     c = cam.coefficients()
-    if cam.model == "fisheye":
+    if camera_model(cam.model).opencv_fisheye:
         d.update(camera_model="OPENCV_FISHEYE", **{k: c[k] for k in ("k1", "k2", "k3", "k4")})
-    elif cam.model == "opencv":
+    elif c:  # perspective with distortion
         if any(c[k] for k in ("k5", "k6", "s1", "s2", "s3", "s4")):
             raise ExportError("NeRF transforms.json supports k1..k4, p1, p2 only (OpenCV model)")
         d.update(camera_model="OPENCV", **{k: c[k] for k in ("k1", "k2", "k3", "k4", "p1", "p2")})

@@ -11,8 +11,6 @@
 """
 from __future__ import annotations
 
-import numpy as np
-
 import cv2
 import numpy as np
 

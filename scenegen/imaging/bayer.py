@@ -9,6 +9,7 @@ tests/test_imaging_bayer.py against a mosaic of a known colour).
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 PATTERNS = ("RGGB", "BGGR", "GRBG", "GBRG")
@@ -47,8 +48,6 @@ def demosaic(raw: np.ndarray, pattern: str, method: str = "bilinear") -> np.ndar
     phase: padded row -2 copies row 2, -1 copies 1), so border pixels get interior-quality
     interpolation instead of OpenCV's one-sided border handling; the result is cropped back.
     """
-    import cv2
-
     if method not in DEMOSAIC_METHODS:
         raise ValueError(f"demosaic method must be one of {DEMOSAIC_METHODS}, got {method!r}")
     suffix = "_EA" if method == "edge_aware" else ""

@@ -18,12 +18,28 @@ from scenegen.crossview.correspondence import correspond, flow_field
 from scenegen.crossview.matches import MatchParams, label_real_matches, sift_matches, synthetic_matches
 from scenegen.crossview.targets import board_view_truth
 from scenegen.dataset.codecs import encode_exr, encode_flo, encode_json, encode_npy, read_png
-from scenegen.dataset.crossview import (INDEX_FORMAT, INDEX_FORMAT_VERSION, INLIER, LABELS, MATCH_COLUMNS,
-                                        OCCLUSION_REL_TOL,
-                                        STATE_NAMES, TWOVIEW_PIXELS, VISIBLE, Correspondence,
-                                        encode_correspondence_channels)
-from scenegen.dataset.layout import (CROSSVIEW_INDEX, correspondence_path, flow_path, matches_path, twoview_path,
-                                     view_paths, view_targets_path)
+from scenegen.dataset.crossview import (
+    INDEX_FORMAT,
+    INDEX_FORMAT_VERSION,
+    INLIER,
+    LABELS,
+    MATCH_COLUMNS,
+    OCCLUSION_REL_TOL,
+    STATE_NAMES,
+    TWOVIEW_PIXELS,
+    VISIBLE,
+    Correspondence,
+    encode_correspondence_channels,
+)
+from scenegen.dataset.layout import (
+    CROSSVIEW_INDEX,
+    correspondence_path,
+    flow_path,
+    matches_path,
+    twoview_path,
+    view_paths,
+    view_targets_path,
+)
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
@@ -121,8 +137,9 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
         c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
         rows = label_real_matches(pi, pj, c.uv.reshape(-1, 2), c.state.ravel() == VISIBLE, cfg.sift_inlier_px)
         ctx.write(matches_path(a, b, "sift"), encode_npy(rows))
-        entry["sift_matches"] = {"count": len(rows), "inliers": int((rows[:, MATCH_COLUMNS.index("label")] == INLIER).sum()),
-                                 "ratio": cfg.sift_ratio, "inlier_px": cfg.sift_inlier_px}
+        inliers = int((rows[:, MATCH_COLUMNS.index("label")] == INLIER).sum())
+        entry["sift_matches"] = {"count": len(rows), "inliers": inliers, "ratio": cfg.sift_ratio,
+                                 "inlier_px": cfg.sift_inlier_px}
     return entry
 
 

@@ -8,10 +8,10 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from scenegen.assets.targets import target_truth
 from scenegen.dataset.cameras import ViewCamera
 from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.layout import target_path
+from scenegen.dataset.targets import target_document
 from scenegen.dataset.writer import DatasetWriter, software_versions
 from scenegen.imaging.stage import imaging_record
 from scenegen.pipeline.crossview import run_crossview
@@ -110,7 +110,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     for name, mesh in built.meshes_world.items():
         writer.write_mesh(name, mesh)
     for name, (board, world_from_board) in built.boards.items():
-        writer.write_file(target_path(name), encode_json(target_truth(board, world_from_board)))
+        writer.write_file(target_path(name), encode_json(target_document(board, world_from_board)))
 
     todo = [(i, v) for i, v in enumerate(views) if wanted is None or v.frame_index in wanted]
     skipped = sum(writer.is_complete(v.name) for _, v in todo)

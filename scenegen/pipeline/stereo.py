@@ -10,7 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.crossview.correspondence import correspond
-from scenegen.dataset.codecs import encode_exr, encode_json, encode_kitti_disparity, encode_pfm, encode_png, pack_channels
+from scenegen.dataset.codecs import (
+    encode_exr,
+    encode_json,
+    encode_kitti_disparity,
+    encode_pfm,
+    encode_png,
+    pack_channels,
+)
 from scenegen.dataset.crossview import VISIBLE, encode_correspondence_channels
 from scenegen.dataset.layout import STEREO_SIDES, stereo_dir, stereo_path
 from scenegen.dataset.truth import LINEAR_CHANNELS

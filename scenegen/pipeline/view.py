@@ -60,5 +60,6 @@ def view_optics(built, view) -> dict | None:
                               "world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau], tau from mid-exposure"}
     ca = getattr(optics, "chromatic_aberration", None)
     if ca is not None:
-        d["channel_cameras"] = {c: cam.to_dict() for c, cam in zip("RGB", ca.channel_cameras(built.cameras[view.camera]))}
+        cams = ca.channel_cameras(built.cameras[view.camera])
+        d["channel_cameras"] = {c: cam.to_dict() for c, cam in zip("RGB", cams)}
     return d or None

@@ -62,7 +62,7 @@ def llvm_available() -> bool:
     """True if Dr.Jit's LLVM back end runs with a libLLVM >= 16."""
     if not configure_llvm():
         return False
-    import drjit as dr
+    import drjit as dr  # only now: DRJIT_LIBLLVM_PATH must be set before Dr.Jit loads
 
     try:
         return dr.has_backend(dr.JitBackend.LLVM) and dr.detail.llvm_version()[0] >= MIN_LLVM_MAJOR
@@ -72,7 +72,7 @@ def llvm_available() -> bool:
 
 def cuda_available() -> bool:
     configure_llvm()
-    import drjit as dr
+    import drjit as dr  # only now: DRJIT_LIBLLVM_PATH must be set before Dr.Jit loads
 
     try:
         return bool(dr.has_backend(dr.JitBackend.CUDA))
@@ -104,7 +104,7 @@ def resolve_variant(requested: str = "auto") -> str:
 def load_mitsuba(variant: str = "auto"):
     """Import Mitsuba with a safe libLLVM and the resolved variant set; returns the module."""
     resolved = resolve_variant(variant)
-    import mitsuba as mi
+    import mitsuba as mi  # only now: after the libLLVM is chosen and the variant resolved
 
     mi.set_variant(resolved)
     return mi

@@ -6,19 +6,6 @@ import math
 
 import drjit as dr
 
+from scenegen.geometry.camera.arith import ArrayOps
 
-class DrJitOps:
-    """sqrt, atan2, sin, cos, select and nan_like on Dr.Jit arrays."""
-
-    sqrt = staticmethod(dr.sqrt)
-    atan2 = staticmethod(dr.atan2)
-    sin = staticmethod(dr.sin)
-    cos = staticmethod(dr.cos)
-    select = staticmethod(dr.select)
-
-    @staticmethod
-    def nan_like(x):
-        return dr.full(type(x), math.nan, dr.width(x))
-
-
-DRJIT_OPS = DrJitOps()
+DRJIT_OPS = ArrayOps(dr.sqrt, dr.atan2, dr.sin, dr.cos, dr.select, lambda x: dr.full(type(x), math.nan, dr.width(x)))

@@ -14,7 +14,6 @@ import numpy as np
 from scenegen.dataset.crossview import OCCLUSION_REL_TOL
 
 
-
 def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarray, np.ndarray]:
     """Distance (N,) float64 metres to the first surface along unit rays from ``origin_world``
     (3,) in directions (N, 3), and the hit points (N, 3) float64 (NaN on misses; t = +inf)."""

@@ -13,12 +13,15 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.kitti`: KITTI uint16 disparity PNGs.
 * :mod:`.flo`: Middlebury optical flow.
 """
-from scenegen.dataset.codecs.exr import (decode_exr, encode_exr, pack_channels, read_exr, unpack_channels,
-                                         write_exr)
+from scenegen.dataset.codecs.exr import decode_exr, encode_exr, pack_channels, read_exr, unpack_channels, write_exr
 from scenegen.dataset.codecs.flo import decode_flo, encode_flo
 from scenegen.dataset.codecs.json import decode_json, encode_json, read_json, write_json
-from scenegen.dataset.codecs.kitti import (decode_kitti_disparity, disparity_from_kitti_array,
-                                           encode_kitti_disparity, kitti_disparity_array)
+from scenegen.dataset.codecs.kitti import (
+                                         decode_kitti_disparity,
+                                         disparity_from_kitti_array,
+                                         encode_kitti_disparity,
+                                         kitti_disparity_array,
+)
 from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png

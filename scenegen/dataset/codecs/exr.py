@@ -13,7 +13,6 @@ import OpenEXR
 
 from scenegen.dataset.files import atomic_write_bytes
 
-
 _EXR_DTYPES = (np.dtype(np.float32), np.dtype(np.uint32))
 
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 
 def _json_default(o: Any):
@@ -50,8 +50,8 @@ def write_json(path, obj: Any) -> None:
 
 
 def read_json(path) -> Any:
-    with open(path, "rb") as f:
-        return json.loads(f.read().decode("utf-8"))
+    """Parse a JSON file; a ValueError names the file."""
+    return read_decoded(path, decode_json)
 
 
 def decode_json(data: bytes) -> Any:

@@ -5,7 +5,7 @@ import io
 
 import numpy as np
 
-from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 
 def encode_npy(arr) -> bytes:
@@ -21,7 +21,8 @@ def write_npy(path, arr) -> None:
 
 
 def read_npy(path) -> np.ndarray:
-    return np.load(path, allow_pickle=False)
+    """Read an NPY file (pickles refused); a ValueError names the file."""
+    return read_decoded(path, decode_npy)
 
 
 def decode_npy(data: bytes) -> np.ndarray:

@@ -7,11 +7,9 @@ with any whitespace between the header tokens and either byte order.
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 
 def encode_pfm(image) -> bytes:
@@ -59,7 +57,4 @@ def write_pfm(path, image) -> None:
 
 def read_pfm(path) -> np.ndarray:
     """Read a PFM file (see :func:`decode_pfm`); ValueError names the file."""
-    try:
-        return decode_pfm(Path(path).read_bytes())
-    except ValueError as e:
-        raise ValueError(f"{path}: {e}") from None
+    return read_decoded(path, decode_pfm)

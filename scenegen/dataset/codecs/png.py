@@ -3,12 +3,10 @@ codec). Lossless; a fixed zlib level so the bytes do not follow cv2's defaults.
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import cv2
 import numpy as np
 
-from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 _PNG_COMPRESSION = 3  # zlib level; any level is lossless, fixed so bytes don't follow cv2 defaults
 
@@ -49,7 +47,4 @@ def write_png(path, img) -> None:
 
 def read_png(path) -> np.ndarray:
     """Read a PNG: (H, W) grey or (H, W, 3) RGB, dtype (uint8/uint16) as stored."""
-    try:
-        return decode_png(Path(path).read_bytes())
-    except ValueError as e:
-        raise ValueError(f"{path}: {e}") from None
+    return read_decoded(path, decode_png)

@@ -43,8 +43,17 @@ monotonic region) project to NaN and are flagged invalid, as do points behind a 
 camera, and NaN inputs.
 """
 from scenegen.geometry.camera.camera import Camera
-from scenegen.geometry.camera.models import (ALL_COEFFS, FISHEYE_COEFFS, MODEL_NAMES, MODELS, OPENCV_COEFFS,
-                                             CameraModel, camera_model, project_xyz, unproject_uv)
+from scenegen.geometry.camera.models import (
+                                             ALL_COEFFS,
+                                             FISHEYE_COEFFS,
+                                             MODEL_NAMES,
+                                             MODELS,
+                                             OPENCV_COEFFS,
+                                             CameraModel,
+                                             camera_model,
+                                             project_xyz,
+                                             unproject_uv,
+)
 from scenegen.geometry.camera.validity import UNDISTORT_TOL_PX
 
 __all__ = ["Camera", "CameraModel", "MODELS", "MODEL_NAMES", "OPENCV_COEFFS", "FISHEYE_COEFFS", "ALL_COEFFS",

@@ -11,24 +11,25 @@ Formulas and parameter orders: :mod:`scenegen.geometry.camera` (OpenCV's, COLMAP
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
 
-class NumpyOps:
-    """The array operations of the camera arithmetic, on numpy arrays."""
+@dataclass(frozen=True)
+class ArrayOps:
+    """The array operations the camera arithmetic uses besides + - * /."""
 
-    sqrt = staticmethod(np.sqrt)
-    atan2 = staticmethod(np.arctan2)
-    sin = staticmethod(np.sin)
-    cos = staticmethod(np.cos)
-    select = staticmethod(np.where)
-
-    @staticmethod
-    def nan_like(x):
-        return np.full(np.shape(x), np.nan)
+    sqrt: Callable
+    atan2: Callable  # atan2(y, x)
+    sin: Callable
+    cos: Callable
+    select: Callable  # select(condition, if_true, if_false)
+    nan_like: Callable  # an array of NaN shaped like its argument
 
 
-NUMPY_OPS = NumpyOps()
+NUMPY_OPS = ArrayOps(np.sqrt, np.arctan2, np.sin, np.cos, np.where, lambda x: np.full(np.shape(x), np.nan))
 
 
 # --- Brown-Conrady with OpenCV's rational and thin-prism terms ----------------------------------

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from scenegen.geometry.camera import interop
-from scenegen.geometry.camera.models import ALL_COEFFS, MODEL_NAMES, camera_model, project_xyz, unproject_uv
+from scenegen.geometry.camera.models import ALL_COEFFS, camera_model, project_xyz, unproject_uv
 from scenegen.geometry.camera.validity import measure_undistortion, pixel_grid_border_and_interior
 
 
@@ -109,7 +109,7 @@ class Camera:
         """(K, dist) for OpenCV: ``cv2.projectPoints`` (opencv/pinhole; note OpenCV ignores skew
         there) or ``cv2.fisheye`` (fisheye; pass ``alpha = skew / fx``). The dist vector is the
         shortest OpenCV length (5, 8 or 12) that keeps every non-zero coefficient."""
-        return interop.opencv_arrays(self)
+        return camera_model(self.model).to_opencv(self)
 
     def with_size(self, width: int, height: int) -> "Camera":
         return Camera(self.model, width, height, self.fx, self.fy, self.cx, self.cy, self.skew, self.dist)
@@ -197,9 +197,10 @@ class Camera:
 
     # ----- COLMAP
     def to_colmap(self) -> tuple[str, list[float]]:
-        """(COLMAP model name, params) with COLMAP's pixel convention (cx, cy + 0.5); see
-        :func:`scenegen.geometry.camera.interop.colmap_model`."""
-        return interop.colmap_model(self)
+        """(COLMAP model name, params) with COLMAP's pixel convention (cx, cy + 0.5): pinhole ->
+        PINHOLE; opencv -> OPENCV (k1, k2, p1, p2 only) or FULL_OPENCV; fisheye -> OPENCV_FISHEYE.
+        COLMAP has no skew and no thin-prism terms on a perspective model: those raise ValueError."""
+        return camera_model(self.model).to_colmap(self)
 
     @classmethod
     def from_colmap(cls, model_name: str, width: int, height: int, params) -> "Camera":

@@ -26,15 +26,17 @@ COLMAP_PRINCIPAL_POINT = {
 
 
 # --- OpenCV --------------------------------------------------------------------------------------
-def opencv_arrays(camera) -> tuple[np.ndarray, np.ndarray]:
-    """(K, dist) for OpenCV: ``cv2.projectPoints`` (pinhole/opencv) or ``cv2.fisheye`` (fisheye,
-    with ``alpha = skew / fx``). A perspective dist is the shortest OpenCV length (5, 8 or 12)
-    that keeps every non-zero coefficient."""
-    if camera.model == "fisheye":
-        return camera.K, np.array(camera.dist)
+def opencv_perspective_arrays(camera) -> tuple[np.ndarray, np.ndarray]:
+    """(K, dist) for ``cv2.projectPoints``: dist is the shortest OpenCV length (5, 8 or 12) that
+    keeps every non-zero coefficient (OpenCV ignores K's skew there)."""
     d = np.array(camera.dist if camera.dist else (0.0,) * 12)
     n = 12 if any(d[8:]) else 8 if any(d[5:8]) else 5
     return camera.K, d[:n].copy()
+
+
+def opencv_fisheye_arrays(camera) -> tuple[np.ndarray, np.ndarray]:
+    """(K, D) for ``cv2.fisheye`` (pass ``alpha = skew / fx``)."""
+    return camera.K, np.array(camera.dist)
 
 
 def opencv_camera_args(K, dist, size) -> tuple:
@@ -59,26 +61,31 @@ def opencv_fisheye_camera_args(K, D, size, alpha: float = 0.0) -> tuple:
 
 
 # --- COLMAP --------------------------------------------------------------------------------------
-def colmap_model(camera) -> tuple[str, list[float]]:
-    """(COLMAP model name, params) with COLMAP's pixel convention (cx, cy + 0.5).
+def colmap_pinhole(camera) -> tuple[str, list[float]]:
+    return "PINHOLE", _colmap_base(camera)
 
-    pinhole -> PINHOLE; opencv with only k1, k2, p1, p2 -> OPENCV, with k3..k6 -> FULL_OPENCV;
-    fisheye -> OPENCV_FISHEYE. COLMAP has no skew and no thin-prism terms on a perspective model:
-    those raise ValueError.
-    """
-    if camera.skew != 0.0:
-        raise ValueError("COLMAP camera models have no skew; this camera has skew != 0")
-    cx, cy = colmap_from_opencv_pixels([camera.cx, camera.cy])
-    base = [camera.fx, camera.fy, float(cx), float(cy)]
-    if camera.model == "pinhole":
-        return "PINHOLE", base
-    if camera.model == "fisheye":
-        return "OPENCV_FISHEYE", base + list(camera.dist)
+
+def colmap_opencv(camera) -> tuple[str, list[float]]:
+    """OPENCV with only k1, k2, p1, p2, FULL_OPENCV with k3..k6; COLMAP has no thin-prism terms
+    on a perspective model (ValueError)."""
+    base = _colmap_base(camera)
     if any(camera.dist[8:]):
         raise ValueError("COLMAP has no perspective model with thin-prism terms s1..s4")
     if any(camera.dist[4:8]):
         return "FULL_OPENCV", base + list(camera.dist[:8])
     return "OPENCV", base + list(camera.dist[:4])
+
+
+def colmap_fisheye(camera) -> tuple[str, list[float]]:
+    return "OPENCV_FISHEYE", _colmap_base(camera) + list(camera.dist)
+
+
+def _colmap_base(camera) -> list[float]:
+    """fx, fy, cx, cy in COLMAP's pixel convention; COLMAP models have no skew (ValueError)."""
+    if camera.skew != 0.0:
+        raise ValueError("COLMAP camera models have no skew; this camera has skew != 0")
+    cx, cy = colmap_from_opencv_pixels([camera.cx, camera.cy])
+    return [camera.fx, camera.fy, float(cx), float(cy)]
 
 
 def colmap_camera_args(model_name: str, width: int, height: int, params) -> tuple:

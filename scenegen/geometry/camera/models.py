@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from scenegen.geometry.camera import arith, validity
+from scenegen.geometry.camera import arith, interop, validity
 
 #: OpenCV's distortion coefficient order (cv2.projectPoints), without the tilt terms.
 OPENCV_COEFFS = ("k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4")
@@ -57,15 +57,20 @@ class CameraModel:
     unproject: Callable  # (xd, yd, p, iterations, ops) -> unit ray (dx, dy, dz)
     fold_limit: Callable  # (p, width, height, describe) -> limit (r^2, or theta for wide_angle)
     undistortion: Callable | None  # (xd, yd, p) -> (bad mask, worst iterations); None: closed form
+    opencv_fisheye: bool  # OpenCV's API for it is cv2.fisheye (else cv2.projectPoints & co.)
+    to_opencv: Callable  # camera -> (K, dist) for that API
+    to_colmap: Callable  # camera -> (COLMAP model name, params in COLMAP's pixel convention)
 
 
 MODELS: dict[str, CameraModel] = {m.name: m for m in (
     CameraModel("pinhole", (), (0,), False, _normalise_none, arith.project_pinhole, arith.unproject_pinhole,
-                validity.no_fold_limit, None),
+                validity.no_fold_limit, None, False, interop.opencv_perspective_arrays, interop.colmap_pinhole),
     CameraModel("opencv", OPENCV_COEFFS, (4, 5, 8, 12), False, _normalise_opencv, arith.project_opencv,
-                arith.unproject_opencv, validity.opencv_fold_limit, validity.opencv_undistortion),
+                arith.unproject_opencv, validity.opencv_fold_limit, validity.opencv_undistortion,
+                False, interop.opencv_perspective_arrays, interop.colmap_opencv),
     CameraModel("fisheye", FISHEYE_COEFFS, (4,), True, _normalise_fisheye, arith.project_fisheye,
-                arith.unproject_fisheye, validity.fisheye_fold_limit, validity.fisheye_undistortion),
+                arith.unproject_fisheye, validity.fisheye_fold_limit, validity.fisheye_undistortion,
+                True, interop.opencv_fisheye_arrays, interop.colmap_fisheye),
 )}
 #: Model names in registry order (what a spec's ``model:`` accepts).
 MODEL_NAMES = tuple(MODELS)

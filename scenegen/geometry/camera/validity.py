@@ -17,8 +17,14 @@ import math
 
 import numpy as np
 
-from scenegen.geometry.camera.arith import (distort_opencv_jacobian_xy, distort_opencv_xy, fisheye_dtheta_d,
-                                            fisheye_newton_step, fisheye_theta_d, newton_step_opencv_xy)
+from scenegen.geometry.camera.arith import (
+    distort_opencv_jacobian_xy,
+    distort_opencv_xy,
+    fisheye_dtheta_d,
+    fisheye_newton_step,
+    fisheye_theta_d,
+    newton_step_opencv_xy,
+)
 from scenegen.geometry.conventions import in_image
 
 #: Reprojection residual (px, float64) that sets each camera's undistortion iteration count.

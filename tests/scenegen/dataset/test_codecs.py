@@ -7,8 +7,7 @@ import numpy as np
 import OpenEXR
 import pytest
 
-from scenegen.dataset import codecs as sio
-from scenegen.dataset import files
+from scenegen.dataset import codecs as sio, files
 
 
 def _temp_files(directory):

@@ -9,9 +9,7 @@ import pytest
 import trimesh
 
 from scenegen import dataset as ds
-from scenegen.dataset import codecs as sio
-from scenegen.dataset import files
-from scenegen.dataset import writer as writer_module
+from scenegen.dataset import codecs as sio, files, writer as writer_module
 from scenegen.geometry.pose import Rigid3, look_at
 
 SPEC_SHA = "ab" * 32

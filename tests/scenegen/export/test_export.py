@@ -6,12 +6,11 @@ import cv2
 import numpy as np
 import pytest
 
-from scenegen.dataset import codecs as sio
 from scenegen.cli import main
+from scenegen.dataset import Dataset, codecs as sio
+from scenegen.dataset.codecs import decode_pfm
 from scenegen.geometry.conventions import cam_from_world_from_opengl
 from scenegen.geometry.rotation import matrix_from_quat_wxyz
-from scenegen.dataset.codecs import decode_pfm
-from scenegen.dataset import Dataset
 
 # pycolmap's projection of each exported 3D point vs ours: the bound (float64 both).
 TOL_COLMAP_PX = 1e-6

@@ -6,9 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from scenegen.dataset import codecs as sio
 from scenegen.cli import main
-from scenegen.dataset import Dataset, verify
+from scenegen.dataset import Dataset, codecs as sio, verify
 
 #: Issue 4: the image ratio with / without vignetting must reproduce the saved map within 1 %.
 RATIO_REL_TOL = 0.01

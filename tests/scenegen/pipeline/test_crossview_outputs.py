@@ -5,13 +5,25 @@ import cv2
 import numpy as np
 import pytest
 
-from scenegen.dataset import codecs as sio
-from scenegen.dataset.codecs import (decode_pfm, disparity_from_kitti_array as decode_kitti, encode_pfm, kitti_disparity_array as encode_kitti)
-from scenegen.dataset.codecs.flo import decode_flo, encode_flo
-from scenegen.dataset.crossview import INLIER, NEAR_MISS_OUTLIER, NO_TRUTH, UNIFORM_OUTLIER, WRONG
 from scenegen.crossview.matches import MatchParams, synthetic_matches
-from scenegen.dataset import Dataset, verify
-from scenegen.dataset.crossview import OCCLUDED, VISIBLE, decode_correspondence_channels
+from scenegen.dataset import Dataset, codecs as sio, verify
+from scenegen.dataset.codecs import (
+    decode_pfm,
+    disparity_from_kitti_array as decode_kitti,
+    encode_pfm,
+    kitti_disparity_array as encode_kitti,
+)
+from scenegen.dataset.codecs.flo import decode_flo, encode_flo
+from scenegen.dataset.crossview import (
+    INLIER,
+    NEAR_MISS_OUTLIER,
+    NO_TRUTH,
+    OCCLUDED,
+    UNIFORM_OUTLIER,
+    VISIBLE,
+    WRONG,
+    decode_correspondence_channels,
+)
 
 pytestmark = pytest.mark.render
 
@@ -205,10 +217,10 @@ def test_partial_runs_then_resume_equal_one_full_run(tmp_path):
 
 def test_board_truth_charuco_markers_and_back_side():
     """numpy-only: a ChArUco board seen from its printed side, then from behind."""
-    from scenegen.geometry.camera import Camera
-    from scenegen.crossview.targets import board_view_truth
-    from scenegen.geometry.pose import Rigid3
     from scenegen.assets.targets import charuco_board
+    from scenegen.crossview.targets import board_view_truth
+    from scenegen.geometry.camera import Camera
+    from scenegen.geometry.pose import Rigid3
 
     board = charuco_board(5, 4, 0.04, 0.03, px_per_square=20)
     cam = Camera("opencv", 320, 240, 300.0, 300.0, 159.5, 119.5, 0.0, (-0.1, 0.01, 0, 0))

@@ -4,9 +4,8 @@ import cv2
 import numpy as np
 import pytest
 
-from scenegen.dataset import codecs as sio
+from scenegen.dataset import Dataset, codecs as sio
 from scenegen.dataset.codecs import decode_pfm, disparity_from_kitti_array as decode_kitti
-from scenegen.dataset import Dataset
 from scenegen.dataset.crossview import decode_correspondence_channels
 
 # Stored (float32) rectified correspondences vs f B / Z: float32 rounding of u (~1e-5 px).

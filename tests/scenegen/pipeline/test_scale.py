@@ -12,8 +12,8 @@ import pytest
 
 from scenegen.cli import main
 from scenegen.dataset import Dataset, verify
-from scenegen.errors import SpecError
 from scenegen.dataset.files import sha256_file
+from scenegen.errors import SpecError
 from scenegen.spec import load_spec, parse_spec, spec_sha256, spec_to_dict
 
 VARIED = """
