@@ -218,3 +218,46 @@ class TestNpy:
         with pytest.raises(ValueError):
             sio.write_npy(tmp_path / "o.npy", np.array([{"a": 1}], dtype=object))
         assert not (tmp_path / "o.npy").exists()
+
+
+class TestPfm:
+    def test_round_trip_bottom_row_first_and_inf(self, tmp_path):
+        a = np.arange(12, dtype=np.float32).reshape(3, 4)
+        a[0, 1] = np.inf
+        data = sio.encode_pfm(a)
+        assert data.startswith(b"Pf\n4 3\n-1.0\n")
+        assert np.frombuffer(data[len(b"Pf\n4 3\n-1.0\n"):], "<f4")[:4].tolist() == a[2].tolist()  # bottom row first
+        sio.write_pfm(tmp_path / "d.pfm", a)
+        assert np.array_equal(sio.read_pfm(tmp_path / "d.pfm"), a)
+
+    def test_colour_big_endian_and_loose_whitespace(self):
+        a = np.random.default_rng(0).random((2, 3, 3)).astype(np.float32)
+        data = b"PF  3\t2\n1.0\n" + np.ascontiguousarray(a[::-1]).astype(">f4").tobytes()
+        assert np.array_equal(sio.decode_pfm(data), a)
+
+    def test_nan_is_written_as_unknown(self):
+        assert np.isinf(sio.decode_pfm(sio.encode_pfm(np.array([[np.nan]]))))[0, 0]
+
+    @pytest.mark.parametrize("data, msg", [(b"P6\n1 1\n-1\n" + b"\0" * 4, "not a PFM"),
+                                           (b"Pf\n4 4\n-1.0\n" + b"\0" * 8, "truncated"),
+                                           (b"Pf\nx 1\n-1\n", "not a PFM")])
+    def test_errors(self, tmp_path, data, msg):
+        (tmp_path / "bad.pfm").write_bytes(data)
+        with pytest.raises(ValueError, match=msg) as e:
+            sio.read_pfm(tmp_path / "bad.pfm")
+        assert "bad.pfm" in str(e.value)
+
+
+class TestKitti:
+    def test_round_trip_and_invalid_values(self):
+        d = np.array([[0.0, 1.0 / 512, 3.25, 255.99], [np.inf, -1.0, 256.0, 1.0]])
+        q = sio.kitti_disparity_array(d, valid=np.array([[1, 1, 1, 1], [1, 1, 1, 0]], bool))
+        # 0 and 1/512 round to 0 (invalid), inf/negative invalid, 256 does not fit, masked invalid
+        assert q.tolist() == [[0, 0, 832, 65533], [0, 0, 0, 0]]
+        disp, ok = sio.decode_kitti_disparity(sio.encode_kitti_disparity(d))
+        assert ok.tolist() == [[False, False, True, True], [False, False, False, True]]
+        assert disp[0, 2] == 3.25 and disp[1, 3] == 1.0
+
+    def test_refuses_non_uint16(self):
+        with pytest.raises(ValueError, match="uint16"):
+            sio.disparity_from_kitti_array(np.zeros((2, 2), np.uint8))
