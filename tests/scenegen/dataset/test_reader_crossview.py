@@ -62,3 +62,22 @@ def test_missing_truth_is_named(ds):
         ds.crossview.correspondence("st_right_0000", "side_0002")
     with pytest.raises(KeyError, match="no rectified stereo frame"):
         ds.crossview.stereo("side_0002")
+
+
+def test_stereo_frames_without_pairs():
+    """An index with stereo frames and no pairs (a stereo rig, crossview.pairs: none) still lists
+    its frames: the index is not 'empty' because it has no pairs."""
+    from scenegen.dataset.crossview_reader import CrossviewTruth
+
+    doc = {"format": "scenegen-crossview", "format_version": 1, "occlusion_rel_tol": 1e-4, "pairs": [], "flow": [],
+           "stereo": [{"left_view": "l0", "right_view": "r0", "dir": "crossview/stereo/l0"}], "targets": []}
+
+    class Fake:
+        def has(self, rel):
+            return True
+
+        def read(self, rel, reader, what):
+            return doc
+
+    cv = CrossviewTruth(Fake())
+    assert len(cv) == 0 and [(f.left_view, f.right_view) for f in cv.stereo_frames()] == [("l0", "r0")]
