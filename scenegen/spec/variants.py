@@ -1,6 +1,7 @@
 """Scene variants: ``(spec, seed, index) -> SceneSpec``, a pure, deterministic function.
 
-A spec's ``variation:`` section (:mod:`scenegen.spec.variation`) declares ranges; variant
+A spec's ``variation:`` section (:mod:`scenegen.spec.model.variation`, parsed by
+:mod:`scenegen.spec.parse.variation`) declares ranges; variant
 ``index`` draws each range from its own random stream, ``SeedSequence([seed, index,
 crc32(field path)])``, so one field's draws do not depend on which other fields are declared.
 The variant spec is a new frozen :class:`~scenegen.spec.model.SceneSpec`; its ``variant`` field
@@ -108,7 +109,7 @@ def _vary_light(light, lv, seed: int, index: int, drawn: dict):
             changes["position"] = pos
             if isinstance(light, m.SpotLight):
                 try:
-                    changes["world_from_light"] = look_at(pos, light.target, (0.0, 0.0, 1.0))
+                    changes["world_from_light"] = look_at(pos, light.target, m.WORLD_UP)
                 except ValueError:
                     changes["world_from_light"] = look_at(pos, light.target, (0.0, 1.0, 0.0))
     drawn[light.name] = d
