@@ -13,7 +13,8 @@ from pathlib import Path
 
 from scenegen.pipeline.distributed import open_client
 from scenegen.pipeline.run import render_spec
-from scenegen.spec.variants import SpecSource, derive_variant, variant_dir_name
+from scenegen.spec.source import SpecSource
+from scenegen.spec.variants import derive_variant, variant_dir_name
 
 __all__ = ["render_many"]
 

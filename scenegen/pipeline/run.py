@@ -21,7 +21,7 @@ from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
 from scenegen.spec.model import effective_spp
-from scenegen.spec.variants import SpecSource
+from scenegen.spec.source import SpecSource
 from scenegen.spec.views import light_scales_dict
 
 

@@ -1,8 +1,11 @@
 """The YAML scene spec: parsing into frozen dataclasses, validation, view resolution.
 
-Layers: :mod:`.model` (dataclasses) <- :mod:`.load` (YAML + validation) and :mod:`.views`
-(view sets -> poses) <- :mod:`.serialize` (JSON-able form, hash). Nothing here imports Mitsuba.
-The format is documented in ``docs/scene_spec.md``.
+Layers, each importing only those before it: :mod:`.model` (dataclasses holding every default,
+unit and range) <- :mod:`.views` (view sets -> poses) <- :mod:`.parse` (one module per YAML
+section) <- :mod:`.load` (file / text entry points) <- :mod:`.serialize` (JSON-able form, hash),
+:mod:`.variants` (``--variants``), :mod:`.source` (what a worker needs to rebuild a spec).
+:mod:`.reference` renders the defaults table of ``docs/scene_spec.md``. Nothing here imports
+Mitsuba. The format is documented in ``docs/scene_spec.md``.
 
     >>> spec = load_spec("scenes/examples/orbit_objects.yaml")   # doctest: +SKIP
     >>> views = resolve_views(spec)                               # doctest: +SKIP

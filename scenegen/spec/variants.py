@@ -1,6 +1,7 @@
 """Scene variants: ``(spec, seed, index) -> SceneSpec``, a pure, deterministic function.
 
-A spec's ``variation:`` section (:mod:`scenegen.spec.variation`) declares ranges; variant
+A spec's ``variation:`` section (:mod:`scenegen.spec.model.variation`, parsed by
+:mod:`scenegen.spec.parse.variation`) declares ranges; variant
 ``index`` draws each range from its own random stream, ``SeedSequence([seed, index,
 crc32(field path)])``, so one field's draws do not depend on which other fields are declared.
 The variant spec is a new frozen :class:`~scenegen.spec.model.SceneSpec`; its ``variant`` field
@@ -12,10 +13,7 @@ Nothing here imports Mitsuba.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -23,8 +21,9 @@ from scenegen.errors import SpecError
 from scenegen.geometry import seeds
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
+from scenegen.spec.views import placement_poses, resolve_views
 
-__all__ = ["VARIANT_DIR_FORMAT", "variant_dir_name", "derive_variant", "check_variant", "SpecSource"]
+__all__ = ["VARIANT_DIR_FORMAT", "variant_dir_name", "derive_variant", "check_variant"]
 
 #: Folder of variant ``i`` under the output folder of ``--variants``.
 VARIANT_DIR_FORMAT = "variant_{:04d}"
@@ -110,7 +109,7 @@ def _vary_light(light, lv, seed: int, index: int, drawn: dict):
             changes["position"] = pos
             if isinstance(light, m.SpotLight):
                 try:
-                    changes["world_from_light"] = look_at(pos, light.target, (0.0, 0.0, 1.0))
+                    changes["world_from_light"] = look_at(pos, light.target, m.WORLD_UP)
                 except ValueError:
                     changes["world_from_light"] = look_at(pos, light.target, (0.0, 1.0, 0.0))
     drawn[light.name] = d
@@ -138,12 +137,10 @@ def _vary_camera(cam: m.CameraSpec, cv, seed: int, index: int, drawn: dict) -> m
 
 def _jitter_views(spec: m.SceneSpec, pj, seed: int, index: int, drawn: list) -> tuple:
     """Each view set's placements as an explicit pose list, each pose offset in its own frame."""
-    from scenegen.spec.views import _placement_poses
-
     out = []
     for k, vs in enumerate(spec.view_sets):
         poses = []
-        for j, world_from_x in enumerate(_placement_poses(vs)):
+        for j, world_from_x in enumerate(placement_poses(vs)):
             rng = _rng(seed, index, f"variation.views.{k}.{j}")
             t = _uniform(rng, [-pj.translation_m] * 3, [pj.translation_m] * 3)
             axis = rng.normal(size=3)
@@ -192,8 +189,6 @@ def derive_variant(spec: m.SceneSpec, index: int, seed: int | None = None) -> m.
 
 def check_variant(spec: m.SceneSpec) -> None:
     """Raise SpecError (naming the variant and its section) if a drawn variant is impossible."""
-    from scenegen.spec.views import resolve_views
-
     index = (spec.variant or {}).get("index")
     for name, cam in spec.cameras.items():
         try:
@@ -203,36 +198,3 @@ def check_variant(spec: m.SceneSpec) -> None:
             raise SpecError.at(where, f"variant {index}: camera {name!r} with drawn intrinsics is "
                                f"impossible: {e}; narrow the ranges") from None
     resolve_views(spec)
-
-
-@dataclass(frozen=True)
-class SpecSource:
-    """What a worker process needs to rebuild a spec exactly: the YAML text, the file name its
-    errors name, the folder relative paths resolve against, and the variant index (None = the
-    spec as written). Picklable, unlike the SceneSpec (read-only mappings)."""
-
-    text: str
-    file: str
-    base_dir: str
-    variant_index: int | None = None
-
-    @classmethod
-    def from_path(cls, path, variant_index: int | None = None) -> "SpecSource":
-        p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            raise SpecError(f"cannot read the spec file: {getattr(e, 'strerror', None) or e}", file=str(path)) from None
-        return cls(text, str(path), str(p.resolve().parent), variant_index)
-
-    @property
-    def key(self) -> str:
-        """A hash identifying the spec and variant (a worker's scene cache key)."""
-        h = hashlib.sha256("\0".join((self.text, self.file, self.base_dir, str(self.variant_index))).encode())
-        return h.hexdigest()
-
-    def load(self) -> m.SceneSpec:
-        from scenegen.spec import parse_spec
-
-        spec = parse_spec(self.text, file=self.file, base_dir=self.base_dir)
-        return spec if self.variant_index is None else derive_variant(spec, self.variant_index)

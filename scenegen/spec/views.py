@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from scenegen.errors import SpecError
+from scenegen.geometry.optics import Motion
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
 
@@ -31,7 +32,7 @@ _MAX_REDRAWS = 1000
 def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
     """All views of ``spec``, in order: view set by view set, placement by placement, and within
     a rig placement member by member. Deterministic (random view sets use their seeds)."""
-    per_set = [_placement_poses(vs) for vs in spec.view_sets]  # world_from_X lists
+    per_set = [placement_poses(vs) for vs in spec.view_sets]  # world_from_X lists
     n_frames = sum(len(p) for p in per_set)
     width = max(4, len(str(max(n_frames - 1, 0))))
     views: list[m.View] = []
@@ -51,7 +52,7 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
                         cam_from_world=world_from_cam.inverse(), rig=rig.name,
                         rig_member=member.name, frame_index=frame, view_set=set_index,
-                        motion=_member_motion(vs.motion, member.rig_from_cam), light_scales=scales))
+                        motion=member_motion(vs.motion, member.rig_from_cam), light_scales=scales))
             frame += 1
     return tuple(views)
 
@@ -71,7 +72,7 @@ def light_scales_dict(spec: m.SceneSpec, scales: tuple[float, ...] | None) -> di
     return {light.name: float(k) for light, k in zip(spec.lights, scales)}
 
 
-def _placement_poses(vs: m.ViewSet) -> list[Rigid3]:
+def placement_poses(vs: m.ViewSet) -> list[Rigid3]:
     """world_from_X for every placement of a view set (X = camera or rig frame)."""
     p = vs.placement
     if isinstance(p, m.PoseList):
@@ -79,7 +80,7 @@ def _placement_poses(vs: m.ViewSet) -> list[Rigid3]:
     if isinstance(p, m.LookAtList):
         aims = [(e.eye, e.target, e.up) for e in p.entries]
     elif isinstance(p, m.Orbit):
-        aims = [(eye, p.center, (0.0, 0.0, 1.0)) for eye in orbit_eyes(p)]
+        aims = [(eye, p.center, m.WORLD_UP) for eye in orbit_eyes(p)]
     elif isinstance(p, (m.LinePath, m.CirclePath)):
         eyes = line_eyes(p) if isinstance(p, m.LinePath) else circle_eyes(p)
         aims = [(eye, p.target, p.up) for eye in eyes]
@@ -152,13 +153,11 @@ def random_eyes_targets(p: m.RandomPoses, vs: m.ViewSet | None = None
     return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)
 
 
-def _member_motion(rig_motion, rig_from_cam: Rigid3):
+def member_motion(rig_motion, rig_from_cam: Rigid3):
     """A rig's body velocities seen by one member camera: omega_cam = R^T omega,
     v_cam = R^T (v + omega x t), with rig_from_cam = (R, t)."""
     if rig_motion is None:
         return None
-    from scenegen.geometry.optics import Motion
-
     R, t = rig_from_cam.R, rig_from_cam.t
     w = np.radians(np.asarray(rig_motion.angular_velocity_deg_s, dtype=np.float64))
     v = np.asarray(rig_motion.linear_velocity_mps, dtype=np.float64)

@@ -1,0 +1,106 @@
+"""Cameras (intrinsics, optics, imaging chain) and rigs. Camera models are those of the registry
+:data:`scenegen.geometry.camera.MODELS` (names, distortion coefficients, accepted lengths)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from scenegen.errors import Where
+from scenegen.geometry import optics
+from scenegen.geometry.camera import MODEL_NAMES, Camera
+from scenegen.geometry.pose import Rigid3
+from scenegen.spec.model.meta import describe_foreign, meta, param, part, where_field
+
+RIG_TYPES = ("stereo", "multi")
+_PX = "pixels"
+
+
+@dataclass(frozen=True, kw_only=True)
+class CameraSpec:
+    """Intrinsics (OpenCV pixel convention: pixel (0, 0) is the top-left pixel's centre).
+
+    ``dist`` is in OpenCV's order: opencv k1, k2, p1, p2[, k3[, k4, k5, k6[, s1, s2, s3, s4]]];
+    fisheye (Kannala-Brandt, cv2.fisheye) k1, k2, k3, k4; pinhole ().
+    """
+
+    name: str  # key under `cameras:`
+    model: str = param("pinhole", unit="camera model", choices=MODEL_NAMES)
+    width: int = param(unit="pixels", lo=1)  # YAML `size: [W, H]`, whole pixels
+    height: int = param(unit="pixels", lo=1)
+    fx: float = param(unit=_PX, lo=0.0, lo_open=True, derived="from fov_deg")  # focal length
+    # along u
+    fy: float = param(unit=_PX, lo=0.0, lo_open=True, derived="fx")  # focal length along v
+    cx: float = param(unit=_PX, derived="(width - 1) / 2")  # principal point u
+    cy: float = param(unit=_PX, derived="(height - 1) / 2")  # principal point v
+    skew: float = param(0.0, unit=_PX)  # K[0, 1]
+    dist: tuple[float, ...] = param((), unit="unitless", derived="zeros, the model's shortest "
+                                    "length")  # distortion coefficients, see above
+    fov_deg: float | None = param(None, unit="horizontal field of view, degrees", lo=0.0,
+                                  lo_open=True, hi=180.0, hi_open=True)  # of the undistorted
+    # pinhole as written (fx, fy derived from it: fx = fy = (W/2) / tan(fov/2))
+    optics: Any = part(None, unit="scenegen.geometry.optics.Optics: thin lens, shutter (motion "
+                                  "blur, rolling shutter), chromatic aberration; None = a pinhole "
+                                  "with an instantaneous global shutter")
+    imaging: Any = part(None, unit="scenegen.imaging.ImagingParams: the photometric chain "
+                                   "(docs/image_formation.md); None = the clean sRGB encoding of "
+                                   "the linear render")
+    where: Where | None = where_field()
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(W, H) in pixels."""
+        return (self.width, self.height)
+
+    @property
+    def K(self) -> np.ndarray:
+        """(3, 3) intrinsic matrix."""
+        return np.array([[self.fx, self.skew, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def to_camera(self) -> Camera:
+        """The :class:`scenegen.geometry.camera.Camera` for these intrinsics."""
+        return Camera(model=self.model, width=self.width, height=self.height, fx=self.fx,
+                      fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew, dist=self.dist)
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class RigMember:
+    name: str = param(unit="member name", derived="'left'/'right' for stereo; for multi the "
+                                                  "camera name")
+    camera: str  # a key of `cameras:`
+    rig_from_cam: Rigid3 = part(unit="camera pose in the rig frame (metres)")
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class Rig:
+    """Camera rig. The rig frame has OpenCV camera axes. Stereo: its origin is the left camera
+    centre; the right camera centre is at (+baseline_m, 0, 0); with vergence each camera is
+    turned by vergence_deg / 2 about its own y axis toward the other (toe-in)."""
+
+    name: str  # key under `rigs:`
+    type: str = param(unit="rig type", choices=RIG_TYPES)
+    members: tuple[RigMember, ...]  # stereo: (left, right)
+    baseline_m: float | None = param(None, unit="metres", lo=0.0, lo_open=True,
+                                     doc_default="required (stereo only)")  # distance between
+    # the camera centres; None for a multi rig
+    vergence_deg: float | None = param(None, unit="degrees", lo=0.0, hi=90.0, hi_open=True,
+                                       yaml_default=0.0, doc_default="0 (stereo only)")  # total
+    # toe-in angle; None for a multi rig
+    where: Where | None = where_field()
+
+
+# The lens and time effects of a camera are scenegen.geometry.optics' dataclasses (their defaults
+# stay there); what the spec needs to read them:
+describe_foreign(optics.ThinLens,
+                 f_number=meta("unitless", lo=0.0, lo_open=True),
+                 focus_distance_m=meta("metres", lo=0.0, lo_open=True),
+                 pixel_pitch_um=meta("micrometres", lo=0.0, lo_open=True))
+describe_foreign(optics.Shutter,
+                 exposure_s=meta("seconds", lo=0.0), rolling_readout_s=meta("seconds", lo=0.0))
+describe_foreign(optics.ChromaticAberration,
+                 red_focal_scale=meta("unitless", lo=0.5, hi=2.0),
+                 blue_focal_scale=meta("unitless", lo=0.5, hi=2.0))
+describe_foreign(optics.Motion,
+                 linear_velocity_mps=meta("metres / second"),
+                 angular_velocity_deg_s=meta("degrees / second"))

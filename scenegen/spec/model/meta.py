@@ -1,0 +1,166 @@
+"""Field metadata: the one place where a spec value's default, unit and range are stated.
+
+Every value a spec author writes is a dataclass field declared with :func:`param`, which puts a
+:class:`Meta` (unit, range, allowed values) into the field's metadata next to its default. The
+parsers (:mod:`scenegen.spec.parse`) read default, unit and range from there with
+:func:`field_info` instead of restating them; the reference table in ``docs/scene_spec.md`` is
+generated from the same metadata (:mod:`scenegen.spec.reference`).
+
+Nested records and derived values that are not written as one YAML value are declared with
+:func:`part`. Classes of other packages that a spec fills in (``scenegen.geometry.optics``) get
+their metadata with :func:`describe_foreign`, their defaults staying where they are.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import MISSING, dataclass, field
+from types import MappingProxyType
+from typing import Any, Mapping
+
+#: Key of the spec metadata in ``dataclasses.Field.metadata``.
+META_KEY = "scenegen.spec"
+#: Seeds are unsigned 32-bit integers; ids signed 32-bit (the id images).
+SEED_MAX = 2**32 - 1
+ID_MAX = 2**31 - 1
+#: World up (+z), the default ``up`` of every look-at.
+WORLD_UP = (0.0, 0.0, 1.0)
+
+_WHERE = dict(default=None, compare=False, repr=False)
+
+
+class _NotGiven:
+    def __repr__(self) -> str:
+        return "NOT_GIVEN"
+
+
+#: Marks an unset Meta.yaml_default (dataclasses' MISSING cannot be a field default).
+NOT_GIVEN = _NotGiven()
+
+
+@dataclass(frozen=True)
+class Meta:
+    """What a spec value means and which values it may take."""
+
+    unit: str  # unit or meaning, e.g. 'metres', 'samples per pixel', 'seed', 'flag'
+    label: str | None = None  # how error messages name it, where that differs from unit ('' = not)
+    lo: float | None = None  # smallest allowed value (per element of a vector)
+    hi: float | None = None  # largest allowed value
+    lo_open: bool = False  # lo itself excluded
+    hi_open: bool = False  # hi itself excluded
+    choices: tuple | None = None  # allowed values of an enumeration
+    derived: str | None = None  # when absent from the YAML the parser computes it (how, in words);
+    # the dataclass default is then only a construction default
+    yaml_default: Any = NOT_GIVEN  # the value when absent from the YAML, where it differs from the
+    # construction default (e.g. a stereo rig's vergence 0 while a multi rig has None)
+    part: bool = False  # a nested record or section, not one YAML value (see part())
+    doc_default: str | None = None  # how the docs state the default where one value does not
+    # say it (e.g. 'required for a stereo rig')
+
+    @property
+    def shown(self) -> str:
+        """The unit as the error messages show it."""
+        return self.unit if self.label is None else self.label
+
+    def range_text(self) -> str:
+        """'> 0', '>= 0 and < 1', ... or ''."""
+        parts = []
+        if self.lo is not None:
+            parts.append(f"{'>' if self.lo_open else '>='} {_number(self.lo)}")
+        if self.hi is not None:
+            parts.append(f"{'<' if self.hi_open else '<='} {_number(self.hi)}")
+        return " and ".join(parts)
+
+
+def _number(x) -> str:
+    return str(x) if isinstance(x, int) else f"{x:g}"
+
+
+def param(default: Any = MISSING, *, unit: str, label: str | None = None, lo=None, hi=None,
+          lo_open: bool = False, hi_open: bool = False, choices=None, derived: str | None = None,
+          yaml_default: Any = NOT_GIVEN, doc_default: str | None = None,
+          default_factory: Any = MISSING):
+    """A dataclass field for one spec value: its default and :class:`Meta`."""
+    meta = Meta(unit=unit, label=label, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open,
+                choices=tuple(choices) if choices is not None else None, derived=derived,
+                yaml_default=yaml_default, doc_default=doc_default)
+    return field(default=default, default_factory=default_factory, metadata={META_KEY: meta})
+
+
+def part(default: Any = MISSING, *, unit: str, default_factory: Any = MISSING):
+    """A dataclass field holding a nested record, a section or a resolved value (``unit`` says
+    what it holds); absent means its default."""
+    return field(default=default, default_factory=default_factory,
+                 metadata={META_KEY: Meta(unit=unit, part=True)})
+
+
+def where_field():
+    """The ``where`` of a record (file, line, field path); takes no part in equality."""
+    return field(**_WHERE)
+
+
+def frozen_mapping(d: Mapping | None = None) -> Mapping:
+    """A read-only view of a dict (insertion order kept)."""
+    return MappingProxyType(dict(d or {}))
+
+
+_FOREIGN: dict[type, dict[str, Meta]] = {}
+
+
+def describe_foreign(cls: type, **metas: Meta) -> None:
+    """Attach spec metadata to fields of a dataclass defined outside the spec (its defaults stay
+    in that class)."""
+    names = {f.name for f in dataclasses.fields(cls)}
+    unknown = set(metas) - names
+    if unknown:
+        raise TypeError(f"{cls.__name__} has no fields {sorted(unknown)}")
+    _FOREIGN.setdefault(cls, {}).update(metas)
+
+
+def meta(unit: str, **kw) -> Meta:
+    """A :class:`Meta` for :func:`describe_foreign`."""
+    return Meta(unit=unit, **kw)
+
+
+@dataclass(frozen=True)
+class FieldInfo:
+    """A spec field as the parser needs it."""
+
+    owner: type
+    name: str
+    meta: Meta
+    default: Any  # the value when absent from the YAML; MISSING when required or derived
+
+    @property
+    def required(self) -> bool:
+        return self.default is MISSING and self.meta.derived is None
+
+
+def field_info(cls: type, name: str) -> FieldInfo:
+    """Default and metadata of field ``name`` of ``cls`` (a spec dataclass, or a foreign one
+    described with :func:`describe_foreign`)."""
+    f = {f.name: f for f in dataclasses.fields(cls)}.get(name)
+    if f is None:
+        raise AttributeError(f"{cls.__name__} has no field {name!r}")
+    meta_ = f.metadata.get(META_KEY) or _FOREIGN.get(cls, {}).get(name)
+    if meta_ is None:
+        raise TypeError(f"{cls.__name__}.{name} has no spec metadata (declare it with param())")
+    if meta_.derived is not None:
+        default = MISSING
+    elif meta_.yaml_default is not NOT_GIVEN:
+        default = meta_.yaml_default
+    elif f.default is not MISSING:
+        default = f.default
+    elif f.default_factory is not MISSING:
+        default = f.default_factory()
+    else:
+        default = MISSING
+    return FieldInfo(owner=cls, name=name, meta=meta_, default=default)
+
+
+def spec_fields(cls: type) -> list[FieldInfo]:
+    """Every field of ``cls`` that carries spec metadata, in declaration order."""
+    out = []
+    for f in dataclasses.fields(cls):
+        if META_KEY in f.metadata or f.name in _FOREIGN.get(cls, {}):
+            out.append(field_info(cls, f.name))
+    return out

@@ -1,0 +1,100 @@
+"""``cameras:``: model (from the camera-model registry), size, focal length or field of view,
+principal point, skew, distortion, plus the camera's optics and imaging chain."""
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+from scenegen.geometry.camera import MODELS, CameraModel
+from scenegen.located_yaml import Node, suggest
+from scenegen.spec.model.cameras import CameraSpec
+from scenegen.spec.model.meta import field_info
+from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.imaging import parse_imaging
+from scenegen.spec.parse.optics import OPTICS_KEYS, parse_optics
+from scenegen.spec.parse.read import read_enum, read_float
+
+KEYS = ("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "imaging") + OPTICS_KEYS
+
+
+def coefficient_order(cm: CameraModel) -> str:
+    """The model's coefficients with the optional tails bracketed, e.g. 'k1, k2, p1, p2[, k3[,
+    ...]]' for OpenCV's accepted lengths 4, 5, 8, 12."""
+    lengths, names = cm.dist_lengths, cm.coefficients
+    text = ", ".join(names[:lengths[0]])
+    for a, b in zip(lengths, lengths[1:]):
+        text += "[, " + ", ".join(names[a:b])
+    return text + "]" * (len(lengths) - 1)
+
+
+def parse_camera(node: Node, name: str, ctx: ParseContext) -> CameraSpec:
+    f = node.as_mapping("a camera (a mapping with model, size and fx, fy or fov_deg)")
+    f.check(required=("size",), optional=KEYS)
+    C = CameraSpec
+    model = read_enum(f, C, "model")
+    cm = MODELS[model]
+    size_node = f.get("size")
+    size = size_node.as_floats(2, "width, height in pixels")
+    smallest = field_info(C, "width").meta.lo
+    for item, v in zip(size_node.items(), size):
+        if not v.is_integer() or v < smallest:
+            raise item.error(f"expected a positive whole number of pixels, got {v:g}")
+    W, H = int(size[0]), int(size[1])
+    if "fov_deg" in f:
+        for bad in ("fx", "fy"):
+            if bad in f:
+                raise f.get(bad).error("give either fov_deg or fx and fy, not both")
+        fov = read_float(f, C, "fov_deg")
+        # As scenegen.geometry.camera.Camera.from_fov: the FoV of the undistorted pinhole.
+        fx = fy = (W / 2) / math.tan(math.radians(fov) / 2)
+    else:
+        if "fx" not in f:
+            raise f.missing("fx", " (or give fov_deg)")
+        fx = read_float(f, C, "fx", default=None)
+        fy = read_float(f, C, "fy", default=fx)
+        fov = read_float(f, C, "fov_deg")  # absent
+    cx = read_float(f, C, "cx", default=(W - 1) / 2)
+    cy = read_float(f, C, "cy", default=(H - 1) / 2)
+    skew = read_float(f, C, "skew")
+    dist = parse_dist(f.get("dist"), model, cm)
+    cam = C(name=name, model=model, width=W, height=H, fx=fx, fy=fy, cx=cx, cy=cy, skew=skew,
+            dist=dist, fov_deg=fov, where=node.where,
+            imaging=parse_imaging(f.get("imaging"), name, ctx) if "imaging" in f else None,
+            optics=parse_optics(f, model))
+    if not (-0.5 <= cx <= W - 0.5 and -0.5 <= cy <= H - 0.5):
+        ctx.warn(node, f"principal point ({cx:g}, {cy:g}) lies outside the image")
+    check_camera(cam, f.get("dist") or node)
+    return cam
+
+
+def parse_dist(dn: Node | None, model: str, cm: CameraModel) -> tuple[float, ...]:
+    """``dist`` of a camera of model ``cm``: one of its accepted lengths; absent: zeros of the
+    shortest."""
+    if dn is None:
+        return (0.0,) * cm.dist_lengths[0]
+    if not cm.coefficients:
+        if dn.is_sequence and not dn.items():
+            return ()
+        with_dist = " or ".join(n for n, other in MODELS.items() if other.coefficients)
+        raise dn.error(f"a {model} camera has no distortion; use model: {with_dist}, or "
+                       "remove dist")
+    return dn.as_floats(cm.dist_lengths, f"{model} coefficients {coefficient_order(cm)}")
+
+
+def check_camera(cam: CameraSpec, node: Node) -> None:
+    """Ask scenegen.geometry.camera whether the camera can exist (e.g. a distortion that folds
+    over inside the image); its ValueError becomes a SpecError at ``node``."""
+    try:
+        cam.to_camera()
+    except ValueError as e:
+        raise node.error(f"impossible camera: {e}") from None
+
+
+def camera_ref(node: Node, cameras: Mapping[str, CameraSpec]) -> str:
+    """A name under `cameras:`."""
+    ref = node.as_str("a camera name")
+    if ref not in cameras:
+        defined = ", ".join(cameras) or "none"
+        raise node.error(f"undefined camera {ref!r}{suggest(ref, cameras)}; "
+                         f"defined under cameras: {defined}")
+    return ref

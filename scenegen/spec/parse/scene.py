@@ -1,0 +1,100 @@
+"""The top level of a spec: reads the sections in order, each with a :class:`ParseContext` that
+knows the sections before it, then resolves the views once so that degenerate placements (and
+crossview pairs naming no view) are errors at validation time, not at render time."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from scenegen.errors import SpecError
+from scenegen.located_yaml import Document, Fields, Node
+from scenegen.spec.model.meta import field_info, frozen_mapping
+from scenegen.spec.model.scene import SceneSpec
+from scenegen.spec.parse.cameras import parse_camera
+from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.crossview import check_pair_views, parse_crossview
+from scenegen.spec.parse.lights import parse_light
+from scenegen.spec.parse.materials import parse_material
+from scenegen.spec.parse.objects import parse_object
+from scenegen.spec.parse.read import read_int
+from scenegen.spec.parse.render import parse_render
+from scenegen.spec.parse.rigs import parse_rig
+from scenegen.spec.parse.variation import parse_variation
+from scenegen.spec.parse.views import parse_view_set
+from scenegen.spec.views import resolve_views
+
+TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
+                  "cameras", "rigs", "views", "crossview", "variation")
+#: Scene name of spec text that comes from no file.
+TEXT_SCENE_NAME = "scene"
+
+
+def parse_document(doc: Document) -> SceneSpec:
+    """The validated spec of a composed YAML document."""
+    root = doc.root
+    if root.node is None:
+        raise SpecError("expected a mapping at the top level (keys: "
+                        f"{', '.join(TOP_LEVEL_KEYS)}), got an empty document",
+                        file=doc.file, line=1)
+    f = root.as_mapping("a mapping at the top level (keys: name, objects, cameras, views, ...)")
+    f.check(optional=TOP_LEVEL_KEYS)
+    default_name = TEXT_SCENE_NAME if doc.file.startswith("<") else Path(doc.file).stem
+    name = f.get("name").as_name("a scene name") if "name" in f else default_name
+    description = (f.get("description").as_str() if "description" in f
+                   else field_info(SceneSpec, "description").default)
+    ctx = ParseContext(doc=doc, warnings=[])
+    ctx = ctx.but(scene_seed=read_int(f, SceneSpec, "seed"))
+    ctx = ctx.but(render=parse_render(f.get("render"), ctx))
+    ctx = ctx.but(materials=frozen_mapping(named_section(f, "materials", parse_material, ctx)))
+    ctx = ctx.but(cameras=frozen_mapping(named_section(f, "cameras", parse_camera, ctx)))
+    ctx = ctx.but(rigs=frozen_mapping(named_section(f, "rigs", parse_rig, ctx)))
+    objects = list_section(f, "objects", parse_object, ctx)
+    unique_names(f.get("objects"), objects, "object")
+    ctx = ctx.but(objects=tuple(objects))
+    lights = list_section(f, "lights", parse_light, ctx)
+    unique_names(f.get("lights"), lights, "light")
+    ctx = ctx.but(lights=tuple(lights))  # named by view sets' `lights:`
+    view_sets = list_section(f, "views", parse_view_set, ctx)
+    crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
+        else (None, ())
+    variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
+    spec = SceneSpec(
+        name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
+        materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
+        rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
+        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation)
+    views = resolve_views(spec)  # degenerate placements are errors now, not at render time
+    check_pair_views(pair_views, views)
+    return spec
+
+
+def named_section(f: Fields, key: str, parse: Callable, ctx: ParseContext) -> dict:
+    """A mapping name -> thing; ``parse(node, name, ctx)``."""
+    node = f.get(key)
+    if node is None:
+        return {}
+    section = node.as_mapping(f"a mapping of names to {key}")
+    out = {}
+    for name in section.keys():
+        section.key_node(name).as_name(f"a {key[:-1]} name")
+        out[name] = parse(section.value(name), name, ctx)
+    return out
+
+
+def list_section(f: Fields, key: str, parse: Callable, ctx: ParseContext) -> list:
+    """A list of things; ``parse(node, index, ctx)``."""
+    node = f.get(key)
+    if node is None:
+        return []
+    return [parse(item, i, ctx) for i, item in enumerate(node.items(f"a list of {key}"))]
+
+
+def unique_names(section: Node | None, things, what: str) -> None:
+    seen: dict[str, int | None] = {}
+    for i, thing in enumerate(things):
+        item = section.items()[i]
+        name_node = item.as_mapping().get("name") or item
+        if thing.name in seen:
+            raise name_node.error(f"duplicate {what} name {thing.name!r} (first at line "
+                                  f"{seen[thing.name]})")
+        seen[thing.name] = name_node.line

@@ -1,0 +1,136 @@
+"""``variation:``: seeded ranges for ``scenegen render --variants N``, validated against the
+objects, lights and cameras they name (:mod:`scenegen.spec.model.variation`)."""
+from __future__ import annotations
+
+from scenegen.located_yaml import Node, suggest
+from scenegen.spec.model import variation as mv
+from scenegen.spec.model.geometry import Blob
+from scenegen.spec.model.lights import AreaLight, PointLight, SpotLight
+from scenegen.spec.model.materials import PROCEDURAL_TEXTURE_KINDS, DiffuseMaterial, PlasticMaterial
+from scenegen.spec.model.meta import field_info
+from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.read import read_bool, read_float, seed_or_none
+
+#: Field path the variation seed is derived from (with the scene seed).
+SEED_PATH = "variation"
+
+
+def parse_range(node: Node, cls: type, name: str) -> tuple[float, float]:
+    """[min, max] with min <= max, each in the field's range."""
+    meta = field_info(cls, name).meta
+    a, b = node.as_floats(2, f"min and max, {meta.unit}", lo=meta.lo, lo_open=meta.lo_open)
+    if a > b:
+        raise node.error(f"expected min <= max, got [{a:g}, {b:g}]")
+    return (a, b)
+
+
+def parse_box(node: Node, cls: type, name: str):
+    """{min: [x, y, z], max: [x, y, z]} with max >= min, each in the field's range."""
+    meta = field_info(cls, name).meta
+    unit = meta.unit
+    f = node.as_mapping(f"a box {{min: [x, y, z], max: [x, y, z]}} ({unit})").check(
+        required=("min", "max"))
+    a = f.get("min").as_floats(3, unit, lo=meta.lo, hi=meta.hi)
+    b = f.get("max").as_floats(3, unit, lo=meta.lo, hi=meta.hi)
+    if any(x > y for x, y in zip(a, b)):
+        raise f.get("max").error(f"expected max >= min on every axis, got min {list(a)}, "
+                                 f"max {list(b)}")
+    return a, b
+
+
+def named_entries(section: Node, names: list[str], what: str):
+    """(name, node) per entry of a mapping keyed by names of ``what``s that exist."""
+    f = section.as_mapping(f"a mapping of {what} names to their variation")
+    for name in f.keys():
+        if name not in names:
+            raise f.key_node(name).error(f"undefined {what} {name!r}{suggest(name, names)}; "
+                                         f"{what}s: {', '.join(names) or 'none'}")
+        yield name, f.value(name)
+
+
+def parse_variation(node: Node, ctx: ParseContext) -> mv.VariationSpec:
+    """Parse and validate the ``variation:`` section against the parsed scene."""
+    f = node.as_mapping("a variation section (seed, objects, lights, cameras, views)")
+    f.check(optional=("seed", "objects", "lights", "cameras", "views"))
+    seed = seed_or_none(f, mv.VariationSpec)
+    seed = ctx.seed_for(SEED_PATH) if seed is None else seed
+    objs = [parse_object_variation(name, vn, ctx)
+            for name, vn in named_entries(f.get("objects"), [o.name for o in ctx.objects],
+                                          "object")] if "objects" in f else []
+    lts = [parse_light_variation(name, vn, ctx)
+           for name, vn in named_entries(f.get("lights"), [li.name for li in ctx.lights],
+                                         "light")] if "lights" in f else []
+    cams = [parse_camera_variation(name, vn, ctx)
+            for name, vn in named_entries(f.get("cameras"), list(ctx.cameras),
+                                          "camera")] if "cameras" in f else []
+    views = None
+    if "views" in f:
+        P = mv.PoseJitter
+        vf = f.get("views").as_mapping("a pose jitter (translation_m, rotation_deg)")
+        vf.check(optional=("translation_m", "rotation_deg"))
+        views = P(translation_m=read_float(vf, P, "translation_m"),
+                  rotation_deg=read_float(vf, P, "rotation_deg"), where=f.get("views").where)
+    return mv.VariationSpec(seed=seed, objects=tuple(objs), lights=tuple(lts),
+                            cameras=tuple(cams), views=views, where=node.where)
+
+
+def parse_object_variation(name: str, vn: Node, ctx: ParseContext) -> mv.ObjectVariation:
+    O = mv.ObjectVariation
+    of = vn.as_mapping("an object variation (position, yaw_deg, color, reseed)")
+    of.check(optional=("position", "yaw_deg", "color", "reseed"))
+    obj = next(o for o in ctx.objects if o.name == name)
+    pos = parse_box(of.get("position"), O, "position_min") if "position" in of else (None, None)
+    col = (None, None)
+    if "color" in of:
+        mat = obj.material
+        if not isinstance(mat, (DiffuseMaterial, PlasticMaterial)) or mat.color is None:
+            raise of.get("color").error(
+                f"object {name!r} has a {mat.type} material"
+                f"{' with a texture' if getattr(mat, 'texture', None) else ''}; colour variation "
+                "needs a diffuse or plastic material with a colour")
+        col = parse_box(of.get("color"), O, "color_min")
+    reseed = read_bool(of, O, "reseed")
+    if reseed:
+        tex = getattr(obj.material, "texture", None)
+        procedural = tex is not None and tex.kind in PROCEDURAL_TEXTURE_KINDS
+        if not procedural and not isinstance(obj.geometry, Blob):
+            raise of.get("reseed").error(f"object {name!r} has neither a procedural texture nor "
+                                         "a blob shape: nothing to reseed")
+    return O(object=name, position_min=pos[0], position_max=pos[1],
+             yaw_deg=parse_range(of.get("yaw_deg"), O, "yaw_deg") if "yaw_deg" in of else None,
+             color_min=col[0], color_max=col[1], reseed=reseed, where=vn.where)
+
+
+def parse_light_variation(name: str, vn: Node, ctx: ParseContext) -> mv.LightVariation:
+    L = mv.LightVariation
+    lf = vn.as_mapping("a light variation (intensity_scale, position_jitter_m)")
+    lf.check(optional=("intensity_scale", "position_jitter_m"))
+    jitter = read_float(lf, L, "position_jitter_m")
+    light = next(li for li in ctx.lights if li.name == name)
+    if jitter > 0 and not isinstance(light, (AreaLight, PointLight, SpotLight)):
+        raise lf.get("position_jitter_m").error(
+            f"light {name!r} is a {light.type} light, which has no position")
+    scale = (parse_range(lf.get("intensity_scale"), L, "intensity_scale")
+             if "intensity_scale" in lf else None)
+    return L(light=name, intensity_scale=scale, position_jitter_m=jitter, where=vn.where)
+
+
+def parse_camera_variation(name: str, vn: Node, ctx: ParseContext) -> mv.CameraVariation:
+    C = mv.CameraVariation
+    cf = vn.as_mapping("a camera variation (focal_scale, principal_point_px, dist_jitter)")
+    cf.check(optional=("focal_scale", "principal_point_px", "dist_jitter"))
+    cam = ctx.cameras[name]
+    dist = field_info(C, "dist_jitter").default
+    if "dist_jitter" in cf:
+        n = len(cam.dist)
+        if n == 0:
+            raise cf.get("dist_jitter").error(
+                f"camera {name!r} ({cam.model}) has no distortion coefficients to vary")
+        meta = field_info(C, "dist_jitter").meta
+        dist = cf.get("dist_jitter").as_floats(
+            n, f"one half-width per coefficient of {name!r}'s dist", lo=meta.lo)
+    return C(camera=name,
+             focal_scale=(parse_range(cf.get("focal_scale"), C, "focal_scale")
+                          if "focal_scale" in cf else None),
+             principal_point_px=read_float(cf, C, "principal_point_px"),
+             dist_jitter=dist, where=vn.where)
