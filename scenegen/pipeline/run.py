@@ -68,7 +68,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                 progress: bool = True, dask_client=None) -> RenderSummary:
     """Render every selected view of a spec into ``out_dir`` (see docs/dataset_format.md).
 
-    ``spec_path``: a spec file, or a :class:`scenegen.spec.variants.SpecSource` (e.g. a variant).
+    ``spec_path``: a spec file, or a :class:`scenegen.spec.source.SpecSource` (e.g. a variant).
     ``dask_client``: a ``distributed.Client``; its workers render and write the views, this
     process records them in the run's order (scenegen/pipeline/distributed.py); None = render here.
 

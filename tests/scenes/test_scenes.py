@@ -15,6 +15,7 @@ def test_scene_library_is_not_empty():
     assert "scenes/demo.yaml" in SCENES and len(SCENES) >= 4
 
 
+@pytest.mark.render
 @pytest.mark.parametrize("spec", SCENES)
 def test_scene_renders(spec, tmp_path):
     root = Path(__file__).parents[2]

@@ -32,6 +32,7 @@ def test_look_at_axes():
     np.testing.assert_allclose(world_from_cam.rotate([1.0, 0, 0]), [0, 1.0, 0], atol=1e-12)
 
 
+@pytest.mark.render
 def test_mitsuba_to_world_matches_mitsuba_look_at():
     """Mitsuba's own look_at builds the same camera-to-world (x left, y up, z forward)."""
     import mitsuba as mi

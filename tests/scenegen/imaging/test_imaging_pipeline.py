@@ -68,6 +68,7 @@ def rendered(tmp_path_factory):
     return out
 
 
+@pytest.mark.render
 def test_files_and_records(rendered):
     d = Dataset(rendered)
     assert verify(rendered).ok
@@ -84,6 +85,7 @@ def test_files_and_records(rendered):
     assert d.image("noisy_0002").dtype == np.uint16  # follows render.bit_depth
 
 
+@pytest.mark.render
 def test_rendered_flat_field_ratio_reproduces_saved_map(rendered):
     vig = Dataset(rendered).image("vig_0000").astype(np.float64)
     flat = Dataset(rendered).image("flat_0001").astype(np.float64)
@@ -95,6 +97,7 @@ def test_rendered_flat_field_ratio_reproduces_saved_map(rendered):
     assert err.max() < RATIO_REL_TOL
 
 
+@pytest.mark.render
 def test_two_frames_of_one_camera_get_different_noise(rendered):
     d = Dataset(rendered)
     a, b = d.image("noisy_0002"), d.image("noisy_0003")

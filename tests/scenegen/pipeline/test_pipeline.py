@@ -45,6 +45,7 @@ def rendered(tiny_spec, tmp_path_factory):
     return out
 
 
+@pytest.mark.render
 def test_dataset_contents(rendered):
     d = Dataset(rendered)
     assert d.views == ("cam_0000", "cam_0001", "cam_0002")
@@ -60,6 +61,7 @@ def test_dataset_contents(rendered):
     assert verify(rendered).ok
 
 
+@pytest.mark.render
 def test_same_spec_twice_gives_identical_hashes(tiny_spec, rendered, tmp_path):
     out = tmp_path / "b"
     assert main(["render", str(tiny_spec), "-o", str(out), "-q"]) == 0
@@ -69,6 +71,7 @@ def test_same_spec_twice_gives_identical_hashes(tiny_spec, rendered, tmp_path):
     assert (rendered / "manifest.json").read_bytes() == (out / "manifest.json").read_bytes()
 
 
+@pytest.mark.render
 def test_frames_and_resume(tiny_spec, rendered, tmp_path):
     out = tmp_path / "c"
     assert main(["render", str(tiny_spec), "-o", str(out), "-q", "--frames", "1"]) == 0
@@ -80,6 +83,7 @@ def test_frames_and_resume(tiny_spec, rendered, tmp_path):
     assert a == c  # a resumed, piecewise run equals the one-shot run
 
 
+@pytest.mark.render
 def test_seed_changes_noise_only(tiny_spec, rendered, tmp_path):
     out = tmp_path / "d"
     assert main(["render", str(tiny_spec), "-o", str(out), "-q", "--seed", "5", "--frames", "0"]) == 0

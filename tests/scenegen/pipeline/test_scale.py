@@ -166,6 +166,7 @@ def test_100_variants_are_valid_distinct_and_reproducible(tmp_path):
         assert obj.material.color == tuple(rock["color"]) and obj.geometry.seed == rock["blob_seed"]
 
 
+@pytest.mark.render
 def test_rendered_variants_differ_and_reproduce(tmp_path):
     spec = _write(tmp_path, "varied.yaml", VARIED)
     out_a, out_b = tmp_path / "a", tmp_path / "b"
@@ -188,6 +189,7 @@ def test_rendered_variants_differ_and_reproduce(tmp_path):
 
 
 # --- Dask workers vs a serial run ---------------------------------------------------------------
+@pytest.mark.render
 def test_dask_workers_match_serial_run_and_load_each_scene_once(tmp_path):
     from scenegen.pipeline.distributed import open_client, worker_stats
     from scenegen.pipeline.run import render_spec
@@ -244,6 +246,7 @@ def _run_and_kill(spec: Path, out: Path, *, resume: bool, after_s: float | None 
     return _complete_views(out)
 
 
+@pytest.mark.render
 def test_sigkill_at_several_points_then_resume_gives_the_uninterrupted_dataset(tmp_path):
     from scenegen.pipeline.run import render_spec
 
@@ -276,6 +279,7 @@ _KINDS = {  # kind of file -> how to recognise its relative path
 }
 
 
+@pytest.mark.render
 def test_verify_cli_names_any_file_with_a_flipped_byte(tmp_path, capsys):
     from scenegen.pipeline.run import render_spec
 

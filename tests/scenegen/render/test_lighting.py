@@ -113,6 +113,7 @@ def _render(built, scales, seed=7):
     return render_view(b, "cam", views[0].cam_from_world, spp=16, seed=seed, light_scales=scales)
 
 
+@pytest.mark.render
 def test_emitter_power_keys_cover_every_light_type(built):  # built: Mitsuba loaded first
     from scenegen.render.lights import EMITTER_POWER_PARAM
     from scenegen.spec import model as m
@@ -120,6 +121,7 @@ def test_emitter_power_keys_cover_every_light_type(built):  # built: Mitsuba loa
     assert set(EMITTER_POWER_PARAM) == {m.AreaLight, m.PointLight, m.SpotLight, m.ConstantLight, m.EnvmapLight}
 
 
+@pytest.mark.render
 def test_power_of_two_scale_is_exact(built):
     one = _render(built, (1.0, 0.0, 0.0))
     two = _render(built, (2.0, 0.0, 0.0))
@@ -127,6 +129,7 @@ def test_power_of_two_scale_is_exact(built):
     np.testing.assert_allclose(two, 2.0 * one, rtol=0, atol=TOL_POWER_OF_TWO_SCALE)
 
 
+@pytest.mark.render
 def test_spot_and_envmap_scale(built, tmp_path):
     """The other two light types' power parameters (spot intensity, envmap scale)."""
     from scenegen.dataset import codecs as sio
@@ -158,12 +161,14 @@ views:
     assert not r((0.0, 0.0)).any()
 
 
+@pytest.mark.render
 def test_only_light_at_zero_is_black(built):
     assert not _render(built, (0.0, 0.0, 0.0)).any()
     dark = _render(built, (0.0, 0.0, 0.0), seed=8)
     assert np.array_equal(dark, np.zeros_like(dark))
 
 
+@pytest.mark.render
 def test_lights_superpose(built):
     """With the same lights on (same samples), the image is linear in each light's power:
     image(k) + image(k') = image(k + k')."""
@@ -177,6 +182,7 @@ def test_lights_superpose(built):
     assert rel.max() < TOL_SUPERPOSITION_REL
 
 
+@pytest.mark.render
 def test_light_off_is_as_if_absent(tmp_path):
     """A point or constant light at 0 has no geometry and takes no light samples: the image is
     bit for bit that of the spec without it."""
@@ -204,6 +210,7 @@ def test_light_off_is_as_if_absent(tmp_path):
         assert expected.max() > 0.01 and np.array_equal(got, expected), on
 
 
+@pytest.mark.render
 def test_state_restored_whatever_came_before(built):
     """Every render sets the lighting it needs: None after other lightings is the loaded scene."""
     from scenegen.render.frames import render_view
@@ -234,6 +241,7 @@ def dataset(spec_file, tmp_path_factory):
     return out
 
 
+@pytest.mark.render
 def test_cameras_json_records_view_set_and_lights(dataset):
     views = json.loads((dataset / "cameras.json").read_text())["views"]
     got = {name: (e["view_set"], e["lights"]) for name, e in views.items()}
@@ -245,6 +253,7 @@ def test_cameras_json_records_view_set_and_lights(dataset):
     }
 
 
+@pytest.mark.render
 def test_truth_identical_and_images_differ_across_lightings(dataset):
     d = Dataset(dataset)
     names = d.views
@@ -261,6 +270,7 @@ def test_truth_identical_and_images_differ_across_lightings(dataset):
             assert np.abs(lin[i] - lin[j]).mean() > 1e-3, (names[i], names[j])
 
 
+@pytest.mark.render
 def test_view_order_does_not_matter(spec_file, dataset, tmp_path):
     """Render the last views first (fresh scene), then resume the rest: the same bytes."""
     out = tmp_path / "b"
@@ -292,6 +302,7 @@ crossview: {pairs: none, flow: false, stereo: true, targets: false}
 """
 
 
+@pytest.mark.render
 def test_rectified_stereo_uses_the_left_views_lighting(tmp_path):
     """The lit view renders last, yet the rig's rectified pair is rendered with its lights off."""
     from scenegen.dataset import codecs as sio

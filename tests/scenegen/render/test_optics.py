@@ -62,6 +62,7 @@ views:
 """
 
 
+@pytest.mark.render
 @pytest.mark.parametrize("depth_m", [0.5, 0.7, 1.0, 2.0, 4.0])
 def test_defocus_blur_radius_follows_thin_lens(mi, depth_m):
     """A vertical step edge at depth Z blurs into a disk of radius fx A |1/Z_f - 1/Z| px."""
@@ -132,6 +133,7 @@ def _match_error(detected, truth):
     return d.min(axis=1)
 
 
+@pytest.mark.render
 def test_rolling_shutter_corners_match_per_row_truth(mi):
     from scenegen.render.frames import render_view
     from scenegen.render.truth import truth_pass
@@ -178,6 +180,7 @@ def test_rolling_shutter_corners_match_per_row_truth(mi):
         assert np.linalg.norm(got - P) < 0.002  # within a pixel's footprint (~0.7 mm) of the corner
 
 
+@pytest.mark.render
 def test_chromatic_aberration_moves_each_channel_as_configured(mi):
     from scenegen.render.frames import render_view
 
@@ -224,6 +227,7 @@ views:
 """
 
 
+@pytest.mark.render
 @pytest.mark.parametrize("who", ["camera", "object"])
 def test_motion_blur_streak_is_centred_at_mid_exposure(mi, who):
     """A glowing dot smeared by camera or object motion: centroid at the mid-exposure projection

@@ -39,6 +39,7 @@ CAMERAS = {
 }
 
 
+@pytest.mark.render
 @pytest.mark.parametrize("name", list(CAMERAS))
 def test_emissive_spheres_land_at_projection(mi, name):
     """Tiny emissive spheres placed on a pixel grid at random depths appear exactly there."""
@@ -132,6 +133,7 @@ def _analytic_range(cam, cam_from_world):
     return t_plane.reshape(H, W), t_sphere.reshape(H, W)
 
 
+@pytest.mark.render
 def test_truth_depth_matches_analytic_plane_and_sphere(analytic):
     cam, cam_from_world, truth = analytic
     t_plane, t_sphere = _analytic_range(cam, cam_from_world)
@@ -147,6 +149,7 @@ def test_truth_depth_matches_analytic_plane_and_sphere(analytic):
     assert on_sphere.sum() > 1000 and (valid & ~on_sphere).sum() > 1000
 
 
+@pytest.mark.render
 def test_truth_self_consistency(analytic):
     cam, cam_from_world, truth = analytic
     v = truth["valid"]
@@ -211,6 +214,7 @@ TOL_CHESSBOARD_PX = 0.1
 DETECTOR_BLUR_SIGMA_PX = 1.0
 
 
+@pytest.mark.render
 def test_chessboard_corners_detected_at_truth(mi):
     import cv2
 
@@ -239,6 +243,7 @@ def test_chessboard_corners_detected_at_truth(mi):
         assert err.max() < TOL_CHESSBOARD_PX, err.max()
 
 
+@pytest.mark.render
 def test_envmap_top_row_is_world_up(mi, tmp_path):
     """The spec's convention: an equirectangular map's top row is world +z (Mitsuba's is +y)."""
     from scenegen.dataset import codecs as sio
@@ -270,6 +275,7 @@ views:
     assert horizon[:3].mean(axis=(0, 1))[2] > 0.8
 
 
+@pytest.mark.render
 @pytest.mark.parametrize("sampler", ["ldsampler", "orthogonal", "stratified", "multijitter", "independent"])
 def test_effective_spp_is_what_mitsuba_takes(mi, sampler):
     """The spec layer's rounding rule (no Mitsuba import there) against the plugin itself."""
@@ -280,6 +286,7 @@ def test_effective_spp_is_what_mitsuba_takes(mi, sampler):
     assert [effective_spp(sampler, n) for n in counts] == got
 
 
+@pytest.mark.render
 def test_spp_warning_and_record(tmp_path):
     from scenegen.pipeline.run import render_spec
 
