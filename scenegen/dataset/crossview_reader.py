@@ -200,7 +200,7 @@ class CrossviewTruth:
     def stereo_frames(self) -> tuple[StereoFrame, ...]:
         """Every rectified stereo frame, in order."""
         idx = self.index
-        return tuple(StereoFrame(self._ds, left, right) for left, right in (idx.stereo if idx else ()))
+        return tuple(StereoFrame(self._ds, left, right) for left, right in (idx.stereo if idx is not None else ()))
 
     def stereo(self, left_view: str) -> StereoFrame:
         """The rectified frame whose left view is ``left_view`` (KeyError if there is none)."""
