@@ -31,7 +31,8 @@ from recon_eval.metrics.poses import Poses
 from scenegen.dataset import CAMERAS, MANIFEST, Dataset, DatasetError
 from scenegen.dataset.crossview import VISIBLE, Correspondence, CrossviewIndex, MatchSet
 from scenegen.dataset.crossview_reader import TwoViewTruth
-from scenegen.dataset.layout import CROSSVIEW_INDEX, MATCH_KINDS, correspondence_path, view_paths
+from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, correspondence_path, mesh_path,
+                                     view_paths)
 from scenegen.geometry.conventions import in_image
 
 #: Rectification tolerances of :meth:`DatasetTruth.disparity`: rotations equal to 1e-9 (JSON
@@ -97,7 +98,7 @@ class DatasetTruth:
         """All world-frame meshes concatenated: (vertices (V, 3) float64 m, faces (F, 3) int64)."""
         names = self._ds.mesh_names
         if not names:
-            raise InputError(f"{self.root / MANIFEST}: files: no scene/meshes/*.ply in this dataset")
+            raise InputError(f"{self.root / MANIFEST}: files: no {MESHES_DIR}/*.ply in this dataset")
         Vs, Fs, off = [], [], 0
         for n in names:
             try:
@@ -105,7 +106,7 @@ class DatasetTruth:
             except DatasetError as exc:
                 raise InputError(str(exc)) from None
             except Exception as exc:  # trimesh raises many types on malformed files
-                raise InputError(f"{self.root / 'scene' / 'meshes' / (n + '.ply')}: cannot read ({exc})") from None
+                raise InputError(f"{self._ds.path(mesh_path(n))}: cannot read ({exc})") from None
             V = np.asarray(m.vertices, dtype=np.float64).reshape(-1, 3)
             F = np.asarray(getattr(m, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
             Vs.append(V)
