@@ -1,8 +1,9 @@
 """``recon-eval``: one subcommand per metric family (the table: :mod:`recon_eval.cli.registry`).
 A scored command (:mod:`recon_eval.cli.scored`) prints a table; ``--json OUT`` writes the
 versioned JSON report (see :mod:`recon_eval.report.document`); ``--html OUT`` a self-contained
-HTML report with figures (:mod:`recon_eval.report.html`, needs matplotlib). Bad input -> a message naming the file and what
-was expected, exit code 2, no traceback; ``gate``: exit 1 when a gate fails.
+HTML report with figures (:mod:`recon_eval.report.html`, needs matplotlib). Bad input -> a
+message naming the file and what was expected, exit code 2, no traceback; ``gate``: exit 1 when
+a gate fails.
 
 Wherever it makes sense the truth may be one of our dataset folders (docs/dataset_format.md):
 poses from cameras.json, depth and disparity from the truth EXRs, the GT surface from

@@ -23,7 +23,8 @@ def scored(arguments: Callable, score: Callable) -> Impl:
 
     def add(p) -> None:
         p.add_argument("--json", metavar="OUT", help="write the JSON report here (atomically)")
-        p.add_argument("--html", metavar="OUT", help="write a self-contained HTML report with figures (needs matplotlib)")
+        p.add_argument("--html", metavar="OUT",
+                       help="write a self-contained HTML report with figures (needs matplotlib)")
         p.add_argument("--quiet", action="store_true", help="do not print the table")
         arguments(p)
 

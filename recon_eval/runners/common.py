@@ -14,8 +14,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from recon_eval.errors import NotApplicable
 
 #: Version of the run-result JSON (``command: "run"``); bump when a key changes meaning.
@@ -52,11 +50,6 @@ class Timer:
 
     def __exit__(self, *exc):
         self.s = time.perf_counter() - self.t0
-
-
-def finite_or_inf(x) -> float:
-    x = float(x)
-    return x if np.isfinite(x) else float("inf")
 
 
 def out_path(out_dir: Path, name: str) -> Path:

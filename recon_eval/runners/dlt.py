@@ -2,7 +2,8 @@
 the geometric refinement) per view, on two kinds of 2D-3D input:
 
 * ``targets``: the marker / ChArUco corners detected in the view (``cv2.aruco``,
-  :func:`recon_eval.runners.detect.detect_board_points`), matched by id to the board truth of every board; the DLT needs them on at least two
+  :func:`recon_eval.runners.detect.detect_board_points`), matched by id to the board truth of
+  every board; the DLT needs them on at least two
   planes (a 3D calibration object, scenes/dlt_calibration_object.yaml);
 * ``points``: POINTS_PER_VIEW held-out truth 2D-3D pairs of the view (``points_at_pixels``,
   seeded) with N(0, POINT_SIGMA_PX^2) pixel noise per coordinate.

@@ -14,8 +14,8 @@ Folder layout (``<pair>`` = ``<view1>__<view2>``)::
 Numbers are written with 17 significant digits (float64 round trip). The truth points are the
 hit points of view 1's pixel centres (the dataset's float32 truth read as float64) that view 2
 sees (the dataset's ray-cast visibility, :meth:`DatasetTruth.correspondences`: the pair needs
-correspondence truth), ``count`` of them drawn uniformly (seeded). Their noise-free observations are their projections through P1 and P2, so a perfect
-triangulator recovers them to float64 rounding; for a distorted camera these are undistorted
+correspondence truth), ``count`` of them drawn uniformly (seeded). Their noise-free observations
+are their projections through P1 and P2, so a perfect triangulator recovers them to float64 rounding; for a distorted camera these are undistorted
 pixels, what the camera model's exact inverse gives for the distorted pixel. Then Gaussian noise
 of ``sigma_px`` per coordinate (:func:`recon_eval.metrics.triangulation.noisy_observations`). Selection and
 noise are seeded per pair, :func:`scenegen.geometry.seeds.rng` ``(seed, pair, 0)`` and
