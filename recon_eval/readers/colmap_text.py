@@ -98,7 +98,7 @@ def read_colmap_text(model_dir) -> ColmapModel:
         cids.append(cid)
         i += 2  # skip the POINTS2D line (possibly empty)
     if names and not np.all(np.linalg.norm(np.asarray(qs), axis=1) > 0):
-        raise InputError(f"{d / 'images.txt'}: zero quaternion")
+        raise InputError(f"{d / 'images.txt'}: a zero or non-finite quaternion (QW QX QY QZ)")
     R = rotations_from_quats(qs, d / "images.txt")
     try:
         poses = Poses(tuple(names), R, np.asarray(ts, dtype=np.float64).reshape(-1, 3))

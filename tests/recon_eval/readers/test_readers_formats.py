@@ -119,6 +119,18 @@ class TestColmapText:
         cam = model.cameras[1]
         assert cam.params_opencv_px == (500.0, 505.0, 319.5, 239.5)  # COLMAP 0.5 pixel-centre shift
 
+    def test_bad_quaternions_name_the_file(self, tmp_path, write_colmap):
+        """Quaternions go through scenegen.geometry.rotation (normalised, scipy); a zero or non-finite
+        one is bad input naming images.txt, never NaN rotations."""
+        write_colmap(tmp_path / "nan", [[np.nan, 0, 0, 1]], [[0.0, 0, 0]])
+        with pytest.raises(InputError, match=r"nan/images.txt: a zero or non-finite quaternion"):
+            read_colmap_text(tmp_path / "nan")
+        write_colmap(tmp_path / "zero", [[0.0, 0, 0, 0]], [[0.0, 0, 0]])
+        with pytest.raises(InputError, match=r"zero/images.txt: a zero or non-finite quaternion"):
+            read_colmap_text(tmp_path / "zero")
+        write_colmap(tmp_path / "scaled", [[2.0, 0, 0, 0]], [[0.0, 0, 0]])  # normalised first
+        np.testing.assert_array_equal(read_colmap_text(tmp_path / "scaled").poses.R_cam_from_world[0], np.eye(3))
+
     def test_missing_images_file(self, tmp_path):
         (tmp_path / "m").mkdir()
         (tmp_path / "m" / "cameras.txt").write_text("")
@@ -149,6 +161,20 @@ class TestTum:
 
 
 class TestColmapBinary:
+    def test_bad_quaternion_names_the_file(self, tmp_path):
+        import struct
+
+        from recon_eval.readers.colmap_binary import read_colmap_binary
+
+        d = tmp_path / "bin"
+        d.mkdir()
+        # one PINHOLE camera (model id 1, 4 params), one image with the quaternion (0, 0, 0, 0)
+        (d / "cameras.bin").write_bytes(struct.pack("<QiiQQ4d", 1, 1, 1, 64, 48, 50.0, 50.0, 32.0, 24.0))
+        (d / "images.bin").write_bytes(struct.pack("<QI4d3dI", 1, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1)
+                                       + b"a.png\0" + struct.pack("<Q", 0))
+        with pytest.raises(InputError, match=r"images.bin: quaternion must be 4 finite numbers, not all zero"):
+            read_colmap_binary(d)
+
     def test_same_model_as_text(self, tmp_path, write_colmap):
         import pycolmap
 
