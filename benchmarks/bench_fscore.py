@@ -4,7 +4,7 @@ The Open3D side is the Tanks and Temples toolbox's computation (isl-org/TanksAnd
 python_toolbox/evaluation): ``voxel_down_sample(tau / 2)`` of both clouds,
 ``compute_point_cloud_distance`` both ways, precision = mean(d(rec->gt) < tau), recall =
 mean(d(gt->rec) < tau) (strict <), F = 2PR / (P + R). recon_eval's side is
-:func:`recon_eval.pointcloud.tanks_and_temples` on the same clouds. Both are timed warm (one
+:func:`recon_eval.metrics.pointcloud.tanks_and_temples` on the same clouds. Both are timed warm (one
 untimed run first, then the best of ``--repeats``), from numpy arrays in memory to P/R/F.
 
 Open3D is never installed in the project's environment: on first use this script creates a
@@ -111,7 +111,7 @@ def main() -> int:
     import numpy as np
 
     sys.path.insert(0, str(HERE.parent))
-    from recon_eval.pointcloud import tanks_and_temples
+    from recon_eval.metrics.pointcloud import tanks_and_temples
 
     py = ensure_open3d_venv()
     rec, gt = make_clouds(a.n, a.tau)

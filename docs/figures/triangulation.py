@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from recon_eval import plots
-from recon_eval import triangulation_task as tt
-from recon_eval.dlt import decompose_projection
+from recon_eval.report import plots
+from recon_eval.tasks import triangulation_task as tt
+from recon_eval.metrics.dlt import decompose_projection
 from recon_eval.readers.scenegen_dataset import read_dataset
 
 ROOT = Path(__file__).resolve().parents[2]

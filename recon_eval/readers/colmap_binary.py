@@ -9,9 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.poses import Poses
-from recon_eval.readers._quat import matrix_from_quat_wxyz
-from recon_eval.readers.colmap_text import ColmapModel, make_camera
+from recon_eval.metrics.poses import Poses
+from recon_eval.readers.colmap_text import ColmapModel, make_camera, rotations_from_quats
 
 #: COLMAP model id -> (name, number of parameters) (colmap/src/colmap/sensor/models.h)
 CAMERA_MODELS = {
@@ -23,6 +22,8 @@ CAMERA_MODELS = {
 
 
 class _Reader:
+    """Little-endian struct reads with a truncation check."""
+
     def __init__(self, path: Path):
         self.path = path
         self.data = path.read_bytes()
@@ -72,7 +73,7 @@ def read_colmap_binary(model_dir) -> ColmapModel:
         cids.append(vals[8])
         names.append(r.cstring())
         r.skip(24 * r.read("Q")[0])  # points2D: x, y (double), point3D_id (int64)
-    R = matrix_from_quat_wxyz(np.asarray(qs).reshape(-1, 4)) if names else np.zeros((0, 3, 3))
+    R = rotations_from_quats(qs, d / "images.bin")
     poses = Poses(tuple(names), R, np.asarray(ts, dtype=np.float64).reshape(-1, 3))
     pts = np.zeros((0, 3))
     if (d / "points3D.bin").is_file():

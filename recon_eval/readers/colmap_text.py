@@ -3,7 +3,9 @@
 images.txt stores ``cam_from_world`` as a (QW, QX, QY, QZ) quaternion and (TX, TY, TZ); each image
 takes two lines (header, then its 2D points, possibly empty). COLMAP pixel coordinates put the
 top-left pixel's centre at (0.5, 0.5); this reader converts principal points to OpenCV's (0, 0)
-convention (cx - 0.5, cy - 0.5) for the models it knows, and reports the raw parameters too.
+convention (cx - 0.5, cy - 0.5) for the models with a principal point
+(:func:`scenegen.geometry.camera.interop.opencv_params_from_colmap`), and reports the raw
+parameters too. Quaternions go through :func:`scenegen.geometry.rotation.matrix_from_quat_wxyz`.
 """
 from __future__ import annotations
 
@@ -13,16 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.poses import Poses
-from recon_eval.readers._quat import matrix_from_quat_wxyz
-from recon_eval.readers._text import read_text
-
-#: COLMAP model -> index of (cx, cy) in its parameter list
-_PRINCIPAL_POINT = {
-    "SIMPLE_PINHOLE": (1, 2), "PINHOLE": (2, 3), "SIMPLE_RADIAL": (1, 2), "RADIAL": (1, 2),
-    "OPENCV": (2, 3), "OPENCV_FISHEYE": (2, 3), "FULL_OPENCV": (2, 3), "SIMPLE_RADIAL_FISHEYE": (1, 2),
-    "RADIAL_FISHEYE": (1, 2), "THIN_PRISM_FISHEYE": (2, 3), "FOV": (2, 3),
-}
+from recon_eval.metrics.poses import Poses
+from recon_eval.readers.text import read_text
+from scenegen.geometry.camera.interop import opencv_params_from_colmap
+from scenegen.geometry.rotation import matrix_from_quat_wxyz
 
 
 @dataclass(frozen=True)
@@ -46,11 +42,16 @@ class ColmapModel:
 def make_camera(camera_id: int, model: str, width: int, height: int, params) -> ColmapCamera:
     """A :class:`ColmapCamera` with the OpenCV-convention copy of the parameters."""
     params = tuple(float(v) for v in params)
-    cv = list(params)
-    if model in _PRINCIPAL_POINT and len(cv) > max(_PRINCIPAL_POINT[model]):
-        for i in _PRINCIPAL_POINT[model]:
-            cv[i] -= 0.5
-    return ColmapCamera(camera_id, model, width, height, params, tuple(cv))
+    return ColmapCamera(camera_id, model, width, height, params, opencv_params_from_colmap(model, params))
+
+
+def rotations_from_quats(qs, where) -> np.ndarray:
+    """(N, 3, 3) cam_from_world rotations of (N, 4) (QW, QX, QY, QZ) rows; ``where`` (the file)
+    names a non-finite or zero quaternion."""
+    try:
+        return matrix_from_quat_wxyz(np.asarray(qs, np.float64).reshape(-1, 4))
+    except ValueError as exc:
+        raise InputError(f"{where}: {exc}") from None
 
 
 def _lines(path: Path) -> list[str]:
@@ -97,8 +98,8 @@ def read_colmap_text(model_dir) -> ColmapModel:
         cids.append(cid)
         i += 2  # skip the POINTS2D line (possibly empty)
     if names and not np.all(np.linalg.norm(np.asarray(qs), axis=1) > 0):
-        raise InputError(f"{d / 'images.txt'}: zero quaternion")
-    R = matrix_from_quat_wxyz(np.asarray(qs).reshape(-1, 4)) if names else np.zeros((0, 3, 3))
+        raise InputError(f"{d / 'images.txt'}: a zero or non-finite quaternion (QW QX QY QZ)")
+    R = rotations_from_quats(qs, d / "images.txt")
     try:
         poses = Poses(tuple(names), R, np.asarray(ts, dtype=np.float64).reshape(-1, 3))
     except InputError as exc:

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
+from scenegen.dataset.codecs import read_exr, write_exr
 
 DEPTH_CHANNELS = ("depth_z", "depth", "Z", "Y", "R")
 DISPARITY_CHANNELS = ("disparity", "disp", "Y", "R")
@@ -22,8 +23,6 @@ DISPARITY_CHANNELS = ("disparity", "disp", "Y", "R")
 
 def read_exr_map(path, channel: str | None = None, *, kind: str = "depth") -> np.ndarray:
     """(H, W) float64 map from an EXR file, NaN where the stored value is not finite."""
-    from scenegen.dataset.codecs import read_exr
-
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected an OpenEXR {kind} map)")
@@ -52,8 +51,6 @@ def read_exr_map(path, channel: str | None = None, *, kind: str = "depth") -> np
 
 def write_exr_map(path, image, channel: str = "depth_z") -> None:
     """Write an (H, W) map as one float32 channel (NaN written as +inf, a miss). For tests."""
-    from scenegen.dataset.codecs import write_exr
-
     a = np.asarray(image, dtype=np.float64)
     if a.ndim != 2:
         raise InputError(f"write_exr_map: expected (H, W), got {a.shape}")

@@ -27,7 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers._text import read_text
+from recon_eval.readers.npy import read_npy
+from recon_eval.readers.text import read_text
+from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
 PIXEL_ORIGINS = ("center", "corner")
 SUFFIXES = (".txt", ".npy")
@@ -61,8 +63,6 @@ def read_keypoints(path, pixel_origin: str = "center") -> np.ndarray:
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected keypoints: rows of x y [extra columns])")
     if p.suffix.lower() == ".npy":
-        from recon_eval.readers.npy import read_npy
-
         a = read_npy(p)
         if a.size == 0:  # an empty array of any shape: no keypoint
             a = np.zeros((0, 2))
@@ -86,8 +86,6 @@ def read_keypoints(path, pixel_origin: str = "center") -> np.ndarray:
             pts.append((x, y))
         xy = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     if pixel_origin == "corner":
-        from scenegen.geometry.conventions import opencv_from_colmap_pixels
-
         xy = opencv_from_colmap_pixels(xy)
     return xy
 
@@ -112,8 +110,6 @@ def read_matches(path, n_i: int, n_j: int, kp_file_i=None, kp_file_j=None) -> np
         raise InputError(f"{p}: no such file (expected matches: rows of index_i index_j)")
     out = []
     if p.suffix.lower() == ".npy":
-        from recon_eval.readers.npy import read_npy
-
         a = read_npy(p)
         if a.size == 0:
             return np.zeros((0, 2), dtype=np.int64)

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.poses import Poses
-from recon_eval.readers._text import read_text
+from recon_eval.metrics.poses import Poses
+from recon_eval.readers.text import read_text
 
 CONVENTIONS = ("world_from_cam", "cam_from_world")
 

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers._text import read_text
 from recon_eval.readers.npy import read_npy
+from recon_eval.readers.text import read_text
 
 
 def read_matrix3(path, key: str | None = None) -> np.ndarray:

@@ -27,8 +27,16 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.poses import Poses
-from recon_eval.readers._text import read_text
+from recon_eval.metrics.poses import Poses
+from recon_eval.readers.text import read_text
+from scenegen.geometry.camera import Camera, camera_model
+from scenegen.geometry.camera.interop import COLMAP_MODELS
+from scenegen.geometry.conventions import (cam_from_world_from_opengl, colmap_from_opencv_pixels,
+                                           opencv_from_colmap_pixels, opengl_cam_to_world)
+from scenegen.geometry.pose import Rigid3
+
+#: transforms.json ``camera_model`` values (COLMAP's names) this reader converts.
+NERF_CAMERA_MODELS = ("OPENCV", "OPENCV_FISHEYE", "PINHOLE", "SIMPLE_PINHOLE")
 
 
 @dataclass(frozen=True)
@@ -44,8 +52,6 @@ _INTRINSIC_KEYS = ("fl_x", "fl_y", "camera_angle_x", "camera_angle_y", "cx", "cy
 
 
 def _camera(fields: dict, where: str):
-    from scenegen.geometry.camera import Camera
-
     if "w" not in fields or "h" not in fields:
         return None
     try:
@@ -62,15 +68,13 @@ def _camera(fields: dict, where: str):
             fy = 0.5 * h / math.tan(0.5 * float(fields["camera_angle_y"]))
         else:
             fy = fx
-        from scenegen.geometry.conventions import opencv_from_colmap_pixels
-
         cx, cy = opencv_from_colmap_pixels([float(fields.get("cx", w / 2.0)), float(fields.get("cy", h / 2.0))])
         k = {n: float(fields.get(n, 0.0)) for n in ("k1", "k2", "k3", "k4", "p1", "p2")}
-        model = str(fields.get("camera_model", "OPENCV")).upper()
-        if model == "OPENCV_FISHEYE":
-            return Camera("fisheye", w, h, fx, fy, cx, cy, 0.0, (k["k1"], k["k2"], k["k3"], k["k4"]))
-        if model not in ("OPENCV", "PINHOLE", "SIMPLE_PINHOLE"):
-            raise InputError(f"{where}: camera_model {model!r} is not supported (OPENCV, OPENCV_FISHEYE, PINHOLE)")
+        name = str(fields.get("camera_model", "OPENCV")).upper()
+        if name not in NERF_CAMERA_MODELS:
+            raise InputError(f"{where}: camera_model {name!r} is not supported (OPENCV, OPENCV_FISHEYE, PINHOLE)")
+        if camera_model(COLMAP_MODELS[name]).wide_angle:  # OPENCV_FISHEYE: Kannala-Brandt k1..k4
+            return Camera(COLMAP_MODELS[name], w, h, fx, fy, cx, cy, 0.0, (k["k1"], k["k2"], k["k3"], k["k4"]))
         dist = (k["k1"], k["k2"], k["p1"], k["p2"], k["k3"])
         return Camera("opencv" if any(dist) else "pinhole", w, h, fx, fy, cx, cy, 0.0, dist if any(dist) else ())
     except (TypeError, ValueError) as exc:
@@ -78,8 +82,6 @@ def _camera(fields: dict, where: str):
 
 
 def read_nerf_transforms(path) -> NerfTransforms:
-    from scenegen.geometry.conventions import cam_from_world_from_opengl
-
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a NeRF transforms.json)")
@@ -129,15 +131,12 @@ def write_nerf_transforms(path, poses: Poses, camera=None, *, extension: str = "
     """Write ``poses`` (cam_from_world) as transforms.json (OpenGL camera-to-world), file_path
     ``images/<name><extension>``; intrinsics of ``camera`` (scenegen Camera, pinhole/opencv) at
     top level with cx, cy in the NeRF (pixel + 0.5) convention. For tests and exports."""
-    from scenegen.geometry.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
-    from scenegen.geometry.pose import Rigid3
-
     doc: dict = {}
     if camera is not None:
         cx, cy = colmap_from_opencv_pixels([camera.cx, camera.cy])
         doc.update(w=camera.width, h=camera.height, fl_x=camera.fx, fl_y=camera.fy, cx=float(cx), cy=float(cy))
         c = camera.coefficients()
-        if camera.model == "fisheye":
+        if camera_model(camera.model).wide_angle:
             doc.update(camera_model="OPENCV_FISHEYE", **c)
         else:
             doc.update(camera_model="OPENCV", **{k: c.get(k, 0.0) for k in ("k1", "k2", "p1", "p2", "k3")})

@@ -1,4 +1,5 @@
-"""Plain NumPy ``.npy`` arrays (no pickles), with an expected-shape check."""
+"""Plain NumPy ``.npy`` arrays (no pickles), through :func:`scenegen.dataset.codecs.read_npy`, with
+the evaluator's expected-shape check and errors naming the file."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -6,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
+from scenegen.dataset.codecs import read_npy as decode_npy_file
 
 
 def read_npy(path, shape: tuple | None = None) -> np.ndarray:
@@ -14,7 +16,7 @@ def read_npy(path, shape: tuple | None = None) -> np.ndarray:
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a .npy array)")
     try:
-        a = np.load(p, allow_pickle=False)
+        a = decode_npy_file(p)
     except (ValueError, OSError, EOFError) as exc:
         raise InputError(f"{p}: not a readable .npy array ({exc})") from None
     if not np.issubdtype(a.dtype, np.number) and a.dtype != bool:

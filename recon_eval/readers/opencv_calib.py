@@ -19,10 +19,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers._text import read_text
+from recon_eval.readers.text import read_text
+from scenegen.geometry.camera import Camera, camera_model
 
 K_KEYS = ("camera_matrix", "K", "cameraMatrix")
 D_KEYS = ("distortion_coefficients", "D", "dist_coeffs", "distCoeffs")
@@ -59,9 +61,6 @@ def read_opencv_calibration(path, *, model: str | None = None, size: tuple | Non
     ``model``: ``"opencv"`` or ``"fisheye"`` overrides the file's ``distortion_model``;
     ``size`` (W, H) is used when the file gives no image size.
     """
-    import cv2
-    from scenegen.geometry.camera import Camera
-
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected an OpenCV calibration .yaml/.yml/.json)")
@@ -127,13 +126,11 @@ def read_opencv_calibration(path, *, model: str | None = None, size: tuple | Non
 def write_opencv_calibration(path, camera) -> None:
     """Write a scenegen Camera as OpenCV calibration YAML or JSON (by the extension), the fields
     OpenCV's calibration sample writes plus ``distortion_model``. For tests and exports."""
-    import cv2
-
     K, D = camera.to_opencv()
     fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
     fs.write("image_width", int(camera.width))
     fs.write("image_height", int(camera.height))
     fs.write("camera_matrix", np.asarray(K, np.float64))
     fs.write("distortion_coefficients", np.asarray(D, np.float64).reshape(1, -1))
-    fs.write("distortion_model", "equidistant" if camera.model == "fisheye" else "plumb_bob")
+    fs.write("distortion_model", "equidistant" if camera_model(camera.model).wide_angle else "plumb_bob")
     fs.release()

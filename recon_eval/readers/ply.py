@@ -5,6 +5,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import trimesh
 
 from recon_eval.errors import InputError
 
@@ -21,8 +22,6 @@ class Geometry:
 def read_geometry(path) -> Geometry:
     """Read a point cloud or mesh. A file with faces is a mesh; a cloud has faces None. An empty
     file (no vertices) is allowed (metrics define empty-cloud scores)."""
-    import trimesh  # imported where used
-
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a point cloud or mesh: .ply, .obj, .stl)")

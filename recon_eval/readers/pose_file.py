@@ -7,7 +7,7 @@
 
 A bare matrix is read in ``convention`` (default ``cam_from_world``, OpenCV ``solvePnP``'s
 ``x_cam = R x_world + t``). Non-finite values are kept: a failed estimate is scored as a failure
-(:func:`recon_eval.pnp.pnp_errors`), not refused.
+(:func:`recon_eval.metrics.pnp.pnp_errors`), not refused.
 """
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers._text import read_text
+from recon_eval.readers.npy import read_npy
+from recon_eval.readers.text import read_text
 
 CONVENTIONS = ("cam_from_world", "world_from_cam")
 
@@ -43,8 +44,6 @@ def read_pose(path, convention: str = "cam_from_world") -> tuple[np.ndarray, np.
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a camera pose: .json, .npy or .txt)")
     if p.suffix.lower() == ".npy":
-        from recon_eval.readers.npy import read_npy
-
         R, t = _from_matrix(read_npy(p), p)
     elif p.suffix.lower() == ".json":
         try:

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers._text import read_text
+from recon_eval.readers.npy import read_npy
+from recon_eval.readers.text import read_text
 
 
 @dataclass(frozen=True)
@@ -61,8 +62,6 @@ def read_projection_matrix(path) -> np.ndarray:
     Non-finite entries are kept (scored as a failed estimate)."""
     p = Path(path)
     if p.suffix.lower() == ".npy":
-        from recon_eval.readers.npy import read_npy
-
         return read_npy(p, (3, 4))
     rows = read_rows(p, "a row of the 3x4 camera matrix P", (4,))
     if len(rows) != 3:

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.poses import Poses
-from recon_eval.readers._quat import matrix_from_quat_wxyz
-from recon_eval.readers._text import read_text
+from recon_eval.metrics.poses import Poses
+from recon_eval.readers.text import read_text
+from scenegen.geometry.rotation import matrix_from_quat_wxyz
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ def read_tum(path) -> TumTrajectory:
     if not np.all(np.isfinite(a)) or (len(a) and not np.all(np.linalg.norm(a[:, 4:8], axis=1) > 0)):
         raise InputError(f"{p}: non-finite values or zero quaternions")
     q_wxyz = a[:, [7, 4, 5, 6]]
-    R_wc = matrix_from_quat_wxyz(q_wxyz) if len(a) else np.zeros((0, 3, 3))
+    R_wc = matrix_from_quat_wxyz(q_wxyz)  # finite and non-zero: checked above
     R_cw = np.swapaxes(R_wc, 1, 2)
     t_cw = -np.einsum("nij,nj->ni", R_cw, a[:, 1:4])
     names = tuple(f"{t:.6f}" for t in a[:, 0])

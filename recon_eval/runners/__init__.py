@@ -4,8 +4,10 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 :mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
-:mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
-:mod:`.broken` (deliberately wrong estimators that gates must catch).
+:mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching); shared:
+:mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
+the production methods; :data:`FAULTS` the deliberately broken ones of :mod:`.faults`, which gates
+must catch, run by name the same way.
 
 :func:`run_method` runs one registered method and writes ``OUT/result.json`` (the run-result
 JSON, ``command: "run"``, docs/ci.md) next to the raw outputs.
@@ -14,18 +16,25 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from difflib import get_close_matches
 from pathlib import Path
 
-from recon_eval.runners._common import RUN_SCHEMA_VERSION, NotApplicable, RunOutput, Timer, scene_name
+import cv2
+
+from recon_eval.errors import InputError, NotApplicable
+from recon_eval.readers.scenegen_dataset import read_dataset
+from recon_eval.report.document import document, to_jsonable, write_json_atomic
+from recon_eval.runners.common import RUN_SCHEMA_VERSION, RunOutput, Timer
 
 
 @dataclass(frozen=True)
 class Method:
     name: str
-    module: str  # recon_eval.runners.<module>
+    module: str  # recon_eval.runners.<module>, imported when the method runs
     function: str
     description: str
     options: tuple = ()  # (key, value) pairs passed to the function
+    fault: bool = False  # a deliberately broken estimator (FAULTS)
 
 
 def _m(name, module, function, description, **options):
@@ -62,32 +71,32 @@ METHODS: dict[str, Method] = {m.name: m for m in [
        "normalised linear DLT (H&Z Alg. 7.1, linear steps) on detected board corners and on noisy truth points"),
     _m("opencv-triangulate", "triangulate", "opencv",
        "cv2.triangulatePoints on noisy exact truth correspondences of the cross-view pairs (sigma 0 and 1 px)"),
-    _m("broken-calib-cx", "calibration", "broken_cx", "DELIBERATELY BROKEN: checkerboard calibration, cx + 2 px"),
-    _m("broken-f-transposed", "twoview", "fundamental", "DELIBERATELY BROKEN: RANSAC F, transposed",
-       flag="ransac", transpose=True),
+]}
+
+#: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.
+FAULTS: dict[str, Method] = {m.name: m for m in [
+    Method("broken-calib-cx", "faults", "calib_cx", "DELIBERATELY BROKEN: checkerboard calibration, cx + 2 px",
+           fault=True),
+    Method("broken-f-transposed", "faults", "f_transposed", "DELIBERATELY BROKEN: RANSAC F, transposed",
+           tuple(sorted({"flag": "ransac", "transpose": True}.items())), fault=True),
 ]}
 
 
 def method(name: str) -> Method:
-    from recon_eval.errors import InputError
-    from difflib import get_close_matches
-
-    if name not in METHODS:
-        close = get_close_matches(name, list(METHODS), n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}")
-    return METHODS[name]
+    """The registered method ``name``: a production method, else a fault; InputError otherwise."""
+    if name in METHODS:
+        return METHODS[name]
+    if name in FAULTS:
+        return FAULTS[name]
+    close = get_close_matches(name, list(METHODS) + list(FAULTS), n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}; faults: {', '.join(FAULTS)}")
 
 
 def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
     """Run method ``name`` on the dataset folder ``dataset``; raw outputs and ``result.json`` go to
     ``out_dir``. Returns the result document. Raises InputError (NotApplicable when the dataset
     lacks what the method needs)."""
-    import cv2
-
-    from recon_eval.readers.scenegen_dataset import read_dataset
-    from recon_eval.report import document, to_jsonable, write_json_atomic
-
     m = method(name)
     ds = read_dataset(dataset)
     out = Path(out_dir)
@@ -96,7 +105,7 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
     with Timer() as t:
         res: RunOutput = fn(ds, out, dict(m.options))
     inputs = {"method": m.name, "description": m.description, "options": dict(m.options),
-              "dataset": str(dataset), "scene": scene_name(ds), "raw_files": res.raw_files,
+              "dataset": str(dataset), "scene": ds.scene_name, "raw_files": res.raw_files,
               "notes": res.notes, "seconds": t.s, "opencv_version": cv2.__version__,
               "run_schema_version": RUN_SCHEMA_VERSION}
     doc = document("run", inputs, res.results)
@@ -106,4 +115,4 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
     return doc
 
 
-__all__ = ["METHODS", "Method", "NotApplicable", "RunOutput", "method", "run_method"]
+__all__ = ["METHODS", "FAULTS", "Method", "NotApplicable", "RunOutput", "method", "run_method"]

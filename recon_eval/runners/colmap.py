@@ -3,7 +3,7 @@ spec camera, COLMAP's SIMPLE_RADIAL model initialised from its default focal gue
 intrinsics), exhaustive matching, incremental mapping. CPU only.
 
 Raw output: ``colmap/database.db`` and the largest model ``colmap/sparse/`` (COLMAP binary).
-Scores (recon_eval.poses): APE after Sim(3) Umeyama alignment on the camera centres (rotation
+Scores (recon_eval.metrics.poses): APE after Sim(3) Umeyama alignment on the camera centres (rotation
 error per camera, translation error in metres), registration ratio (an unregistered view is a
 failure with error inf, never dropped), and the sparse cloud mapped by the same Sim(3) into the
 world frame and scored against the scene meshes (point-to-triangle, Chamfer and the fraction
@@ -15,7 +15,12 @@ import shutil
 
 import numpy as np
 
-from recon_eval.runners._common import NotApplicable, RunOutput, out_path
+from recon_eval.errors import NotApplicable
+from recon_eval.metrics.align import Alignment
+from recon_eval.metrics.pointcloud import chamfer, tanks_and_temples
+from recon_eval.metrics.poses import Poses, ape, registration_ratio
+from recon_eval.readers.colmap_binary import read_colmap_binary
+from recon_eval.runners.common import RunOutput, out_path
 
 #: Distance threshold of the sparse-cloud accuracy, metres (Tanks-and-Temples-style precision).
 TAU_M = 0.01
@@ -24,12 +29,7 @@ MAX_FEATURES = 4096
 
 
 def incremental(ds, out_dir, options) -> RunOutput:
-    import pycolmap
-
-    from recon_eval.align import Alignment
-    from recon_eval.pointcloud import chamfer, tanks_and_temples
-    from recon_eval.poses import ape, registration_ratio
-    from recon_eval.readers.colmap_binary import read_colmap_binary
+    import pycolmap  # optional (a dev dependency): only this method needs it
 
     if len(ds.views) < 3:
         raise NotApplicable(f"{ds.root}: SfM needs at least 3 views, the dataset has {len(ds.views)}")
@@ -37,7 +37,7 @@ def incremental(ds, out_dir, options) -> RunOutput:
     shutil.rmtree(work.parent, ignore_errors=True)
     work.mkdir(parents=True)
     for v in ds.views:
-        shutil.copy(ds.root / "images" / f"{v}.png", work / f"{v}.png")
+        shutil.copy(ds.image_path(v), work / f"{v}.png")
     db = work.parent / "database.db"
     ext = pycolmap.FeatureExtractionOptions()
     ext.sift.max_num_features = MAX_FEATURES
@@ -60,8 +60,6 @@ def incremental(ds, out_dir, options) -> RunOutput:
     shutil.rmtree(sparse, ignore_errors=True)
     shutil.rmtree(work, ignore_errors=True)  # the copies of the images
     est_model = read_colmap_binary(model)  # score what was written
-    from recon_eval.poses import Poses
-
     est = est_model.poses
     names = tuple(n.rsplit(".", 1)[0] for n in est.names)
     est = Poses(names, est.R_cam_from_world, est.t_cam_from_world)

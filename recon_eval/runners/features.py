@@ -2,7 +2,7 @@
 scored on the cross-view pairs of a dataset (docs/features.md).
 
 Protocol (D2-Net, Dusmanu et al. 2019, on HPatches): every view of a ``crossview/index.json`` pair
-is converted to 8-bit grey (:func:`recon_eval.runners._common.gray`); the detector-descriptor runs
+is converted to 8-bit grey (:func:`scenegen.geometry.color.to_grey8`); the detector-descriptor runs
 **out of the box** (``cv2.SIFT_create()``, ``cv2.ORB_create()``, ``cv2.AKAZE_create()``,
 ``cv2.BRISK_create()`` with their default parameters: no parameter is set, so ORB keeps at most
 its default 500 keypoints); descriptors of view i and view j are matched by ``cv2.BFMatcher`` with
@@ -12,13 +12,20 @@ descriptors (ORB, AKAZE's MLDB, BRISK).
 Raw output, in recon_eval's feature format (:mod:`recon_eval.readers.features`):
 ``keypoints/<view>.txt`` (``x y size angle response``, OpenCV pixels, float32 values written
 exactly) and ``matches/<i>__<j>.txt`` (``index_i index_j``). The scores are computed from those
-files read back (:mod:`recon_eval.feature_eval`).
+files read back (:mod:`recon_eval.tasks.feature_eval`).
 """
 from __future__ import annotations
 
+import io
+
+import cv2
 import numpy as np
 
-from recon_eval.runners._common import NotApplicable, RunOutput, crossview_index, gray, out_path
+from recon_eval.readers.features import KEYPOINTS_DIR, MATCHES_DIR, match_stem, read_feature_files
+from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
+from scenegen.dataset.files import atomic_write_bytes
+from scenegen.geometry.color import to_grey8
 
 #: detector name -> OpenCV factory (called without arguments: default parameters)
 CV_FACTORIES = {"sift": "SIFT_create", "orb": "ORB_create", "akaze": "AKAZE_create", "brisk": "BRISK_create"}
@@ -27,29 +34,23 @@ KEYPOINT_FMT = "%.9g"
 
 
 def _detector(name: str):
-    import cv2
-
     return getattr(cv2, CV_FACTORIES[name])()
 
 
 def _norm(name: str) -> int:
-    import cv2
-
     return cv2.NORM_L2 if name == "sift" else cv2.NORM_HAMMING
 
 
 def detect(name: str, image) -> tuple[np.ndarray, np.ndarray | None]:
     """Keypoint rows (N, 5) ``x y size angle response`` and descriptors (N, D) (None when N = 0)
     of one image, by OpenCV detector ``name`` with default parameters."""
-    kps, des = _detector(name).detectAndCompute(gray(image), None)
+    kps, des = _detector(name).detectAndCompute(to_grey8(image), None)
     rows = np.array([(k.pt[0], k.pt[1], k.size, k.angle, k.response) for k in kps], np.float64).reshape(-1, 5)
     return rows, des
 
 
 def match_mutual(name: str, des_i, des_j) -> np.ndarray:
     """(M, 2) int64 ``index_i index_j``: brute-force mutual nearest neighbours (cross-check)."""
-    import cv2
-
     if des_i is None or des_j is None or len(des_i) == 0 or len(des_j) == 0:
         return np.zeros((0, 2), np.int64)
     ms = cv2.BFMatcher(_norm(name), crossCheck=True).match(des_i, des_j)
@@ -58,26 +59,14 @@ def match_mutual(name: str, des_i, des_j) -> np.ndarray:
 
 def _write_txt(path, rows, fmt: str, header: str) -> None:
     """np.savetxt, written atomically (a reader never sees half a file)."""
-    import io
-
-    from scenegen.dataset.files import atomic_write_bytes
-
     buf = io.StringIO()
     np.savetxt(buf, rows, fmt=fmt, header=header)
     atomic_write_bytes(path, buf.getvalue().encode())
 
 
 def run(ds, out_dir, options) -> RunOutput:
-    import cv2
-
-    from recon_eval.feature_eval import (DEFAULT_EPS_PX, crossview_pairs, evaluate_features, headline_metrics,
-                                         results_dict)
-    from recon_eval.readers.features import KEYPOINTS_DIR, MATCHES_DIR, match_stem, read_feature_files
-
     name = options["detector"]
-    if not (crossview_index(ds) or {}).get("pairs"):
-        raise NotApplicable(f"{ds.root}: no cross-view pairs (crossview/index.json: pairs)")
-    pairs = crossview_pairs(ds)
+    pairs = list(crossview_pairs(ds))
     views = list(dict.fromkeys(v for p in pairs for v in p))
     out = RunOutput()
     des, counts = {}, {}

@@ -8,7 +8,7 @@ intrinsics (K and distortion of the view's camera, OpenCV models only), on two k
   uniform draws over the image (seeded).
 
 Raw output: ``poses.json``, per input and view ``{rvec, tvec, R, t}`` (cam_from_world, OpenCV's
-convention) or null on failure. Scores (recon_eval.pnp): rotation angle, translation and
+convention) or null on failure. Scores (recon_eval.metrics.pnp): rotation angle, translation and
 camera-centre errors; a failure counts as inf. Headline: median over views; on ``targets`` also the
 median reprojection RMS of the detected corners at the estimated pose (the truth camera model).
 """
@@ -16,9 +16,14 @@ from __future__ import annotations
 
 import json
 
+import cv2
 import numpy as np
 
-from recon_eval.runners._common import NotApplicable, RunOutput, boards, gray, out_path
+from recon_eval.errors import NotApplicable
+from recon_eval.metrics.pnp import pnp_errors
+from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.runners.detect import MARKER_BOARD_KINDS, detect_board_points
+from scenegen.geometry.camera import camera_model
 
 POINTS_PER_VIEW = 200
 POINT_SIGMA_PX = 1.0
@@ -29,44 +34,11 @@ RANSAC_THRESH_PX = 3.0 * POINT_SIGMA_PX
 
 
 def _solver(name: str) -> int:
-    import cv2
-
     return {"iterative": cv2.SOLVEPNP_ITERATIVE, "epnp": cv2.SOLVEPNP_EPNP, "sqpnp": cv2.SOLVEPNP_SQPNP,
             "ippe": cv2.SOLVEPNP_IPPE, "ap3p": cv2.SOLVEPNP_AP3P}[name]
 
 
-def _detect(ds, view, geo, truth):
-    """(image points (N, 2), world points (N, 3)) of a ChArUco / ArUco board in one view."""
-    import cv2
-
-    d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, geo["dictionary"]))
-    g = gray(ds.image(view))
-    P = np.asarray(truth["points_world"], np.float64)
-    ids_truth = {int(k): n for n, k in enumerate(truth["point_ids"])}
-    if geo["kind"] == "charuco":
-        board = cv2.aruco.CharucoBoard((int(geo["squares_x"]), int(geo["squares_y"])), float(geo["square_m"]),
-                                       float(geo["marker_m"]), d)
-        corners, ids, _, _ = cv2.aruco.CharucoDetector(board).detectBoard(g)
-        if ids is None:
-            return np.zeros((0, 2)), np.zeros((0, 3))
-        idx = [ids_truth[int(i)] for i in ids.ravel()]
-        return np.asarray(corners, np.float64).reshape(-1, 2), P[idx]
-    corners, ids, _ = cv2.aruco.ArucoDetector(d).detectMarkers(g)
-    if ids is None:
-        return np.zeros((0, 2)), np.zeros((0, 3))
-    x, X = [], []
-    for c, mid in zip(corners, ids.ravel()):
-        for k in range(4):  # aruco grid truth: id = marker_id * 4 + corner
-            n = ids_truth.get(int(mid) * 4 + k)
-            if n is not None:
-                x.append(c.reshape(4, 2)[k])
-                X.append(P[n])
-    return np.asarray(x, np.float64).reshape(-1, 2), np.asarray(X, np.float64).reshape(-1, 3)
-
-
 def _solve(x, X, K, D, solver: str, ransac: bool):
-    import cv2
-
     if len(x) < 4:
         return None
     try:
@@ -81,24 +53,20 @@ def _solve(x, X, K, D, solver: str, ransac: bool):
 
 
 def run(ds, out_dir, options) -> RunOutput:
-    import cv2
-
-    from recon_eval.pnp import pnp_errors
-
     solver, ransac = options["solver"], options["ransac"]
-    targets = {n: b for n, b in boards(ds).items() if b[0]["kind"] in ("charuco", "aruco_grid", "aruco")}
+    targets = {n: b for n, b in ds.boards().items() if b[0]["kind"] in MARKER_BOARD_KINDS}
     rng = np.random.default_rng(SEED)
     raw: dict = {"targets": {}, "points": {}}
     errs: dict = {"targets": [], "points": []}
     out = RunOutput()
     for v in ds.views:
         cam, pose = ds.camera(v)
-        if cam.model == "fisheye":
+        if camera_model(cam.model).wide_angle:  # solvePnP takes OpenCV's perspective models only
             continue
         K, D = cam.to_opencv()
         inputs = {}
         for name, (geo, truth) in targets.items():
-            x, X = _detect(ds, v, geo, truth)
+            x, X = detect_board_points(ds.image(v), geo, truth)
             if len(x) >= 4:
                 inputs[("targets", f"{v}.{name}")] = (x, X)
         uv, Xp = ds.points_at_pixels(v, max_points=POINTS_PER_VIEW, seed=SEED)

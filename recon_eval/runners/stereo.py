@@ -1,11 +1,12 @@
 """OpenCV stereo matching on the rectified pairs of the cross-view truth
-(``crossview/stereo/<left view>/left.png, right.png``, docs/crossview.md).
+(``crossview/stereo/<left view>/left.png, right.png``, docs/crossview.md), read through the dataset
+reader and converted to grey by :func:`scenegen.geometry.color.to_grey8` (OpenCV's RGB -> grey).
 
 Raw output: ``disparity/<left view>.pfm`` (float32, left image, px; +inf where the matcher gave
 no disparity). Scores against ``disp_left.pfm`` (all pixels with truth) restricted to the
 non-occluded mask ``disp_left_noc.png``: Middlebury v3 bad-0.5/1/2/4 % (strict >), invalid %,
-avgerr, rms (recon_eval.stereo.middlebury), pooled over all frames, plus the median signed error
-(estimate - truth, px) over covered non-occluded pixels: the matcher's disparity bias.
+avgerr, rms (recon_eval.metrics.stereo.middlebury), pooled over all frames, plus the median signed
+error (estimate - truth, px) over covered non-occluded pixels: the matcher's disparity bias.
 
 Matcher settings are fixed from the image width only (never from the truth): numDisparities =
 the smallest multiple of 16 >= width / 4, block size 5 (SGBM: P1 = 8 * 3 * 5^2,
@@ -13,25 +14,20 @@ P2 = 32 * 3 * 5^2, the values OpenCV's stereo_match sample uses).
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
-from recon_eval.runners._common import NotApplicable, RunOutput, crossview_index, gray, out_path
+from recon_eval.errors import NotApplicable
+from recon_eval.metrics.stereo import two_view_metrics
+from recon_eval.readers.pfm import read_pfm
+from recon_eval.runners.common import RunOutput, out_path
+from scenegen.dataset.codecs import write_pfm
+from scenegen.geometry.color import to_grey8
 
 BLOCK = 5
 
 
-def write_pfm(path, disp: np.ndarray) -> None:
-    """(H, W) float -> PFM ``Pf``, little-endian, rows bottom to top; NaN stored as +inf."""
-    d = np.where(np.isfinite(disp), disp, np.inf).astype("<f4")
-    h, w = d.shape
-    with open(path, "wb") as f:
-        f.write(f"Pf\n{w} {h}\n-1.0\n".encode("ascii"))
-        f.write(np.ascontiguousarray(d[::-1]).tobytes())
-
-
 def _matcher(kind: str, width: int):
-    import cv2
-
     nd = 16 * int(np.ceil(width / 4 / 16))
     if kind == "bm":
         m = cv2.StereoBM_create(numDisparities=nd, blockSize=2 * BLOCK + 5)  # BM needs an odd size >= 5
@@ -44,43 +40,32 @@ def _matcher(kind: str, width: int):
 
 
 def run(ds, out_dir, options) -> RunOutput:
-    import cv2
-
-    from recon_eval.readers.kitti_png import read_kitti_disparity
-    from recon_eval.readers.pfm import read_pfm
-
-    idx = crossview_index(ds)
-    if not idx or not idx.get("stereo"):
+    lefts = ds.stereo_left_views()
+    if not lefts:
         raise NotApplicable(f"{ds.root}: no rectified stereo pairs (crossview/index.json: stereo)")
     kind = options["matcher"]
     out = RunOutput()
     ests, gts, masks, signed = [], [], [], []
-    for entry in idx["stereo"]:
-        base = ds.root / entry["dir"]
-        L = cv2.imread(str(base / "left.png"), cv2.IMREAD_UNCHANGED)
-        R = cv2.imread(str(base / "right.png"), cv2.IMREAD_UNCHANGED)
-        if L is None or R is None:
-            raise NotApplicable(f"{base}: left.png / right.png missing")
-        L, R = gray(L[..., ::-1] if L.ndim == 3 else L), gray(R[..., ::-1] if R.ndim == 3 else R)
+    for left in lefts:
+        L, R = (to_grey8(im) for im in ds.stereo_images(left))
         m, nd = _matcher(kind, L.shape[1])
         raw = m.compute(L, R).astype(np.float64) / 16.0  # fixed point, 4 fractional bits
         est = np.where(raw >= 0, raw, np.nan)  # invalid = minDisparity - 1 (/16) -> missing
-        path = out_path(out_dir, f"disparity/{entry['left_view']}.pfm")
+        path = out_path(out_dir, f"disparity/{left}.pfm")
         write_pfm(path, est)
-        out.raw_files.append(f"disparity/{entry['left_view']}.pfm")
+        out.raw_files.append(f"disparity/{left}.pfm")
         est = read_pfm(path)  # score what was written
-        gt = read_pfm(base / "disp_left.pfm")
-        noc = np.isfinite(read_kitti_disparity(base / "disp_left_noc.png"))
+        gt = ds.stereo_disparity(left)
+        noc = ds.stereo_noc_mask(left)
         ests.append(est)
         gts.append(gt)
         masks.append(noc)
         ok = noc & np.isfinite(gt) & np.isfinite(est)
         signed.append((est - gt)[ok])
-        out.notes[f"{entry['left_view']}.num_disparities"] = nd
-    from recon_eval.stereo import _two_view  # pooled over frames (Middlebury counts per pixel)
-
-    noc_res = _two_view(ests, gts, masks, benchmark="middlebury_v3")
-    all_res = _two_view(ests, gts, [np.isfinite(g) for g in gts], benchmark="middlebury_v3")
+        out.notes[f"{left}.num_disparities"] = nd
+    # pooled over frames (Middlebury counts per pixel)
+    noc_res = two_view_metrics(ests, gts, masks, benchmark="middlebury_v3")
+    all_res = two_view_metrics(ests, gts, [np.isfinite(g) for g in gts], benchmark="middlebury_v3")
     s = np.concatenate(signed)
     out.results["middlebury_noc"] = noc_res
     out.results["middlebury_all"] = all_res

@@ -2,7 +2,7 @@
 pair of the dataset (crossview/index.json), at each pixel noise of SIGMAS_PX.
 
 Exactly the user's path: a triangulation task is written per sigma
-(:mod:`recon_eval.triangulation_task`: ``task_sigma<s>/``, the pairs' P = K [R | t] and noisy
+(:mod:`recon_eval.tasks.triangulation_task`: ``task_sigma<s>/``, the pairs' P = K [R | t] and noisy
 exact truth correspondences, COUNT per pair, seeded), OpenCV triangulates its observations, the
 points are written as the answer files (``points_sigma<s>/<pair>.txt``, raw output) and scored from
 the files read back, as ``recon-eval triangulation TASK EST_DIR`` would. Headline metrics per sigma:
@@ -12,8 +12,9 @@ relative error: float precision), and the median error per triangulation-angle b
 """
 from __future__ import annotations
 
-from recon_eval.errors import InputError
-from recon_eval.runners._common import NotApplicable, RunOutput, crossview_index
+from recon_eval.errors import InputError, NotApplicable
+from recon_eval.runners.common import RunOutput, crossview_pairs
+from recon_eval.tasks import triangulation_task as tt
 
 SIGMAS_PX = (0.0, 1.0)
 COUNT = 2000
@@ -25,11 +26,7 @@ def _sigma_tag(s: float) -> str:
 
 
 def opencv(ds, out_dir, options) -> RunOutput:
-    from recon_eval import triangulation_task as tt
-
-    idx = crossview_index(ds)
-    if not idx or not idx.get("pairs"):
-        raise NotApplicable(f"{ds.root}: no cross-view pairs (crossview/index.json: pairs)")
+    crossview_pairs(ds)  # NotApplicable without cross-view pairs
     out = RunOutput()
     try:
         views, skipped = tt.dataset_pairs(ds)

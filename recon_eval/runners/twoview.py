@@ -3,25 +3,34 @@
 and ``findHomography``, each on the labelled synthetic matches and on the SIFT matches of every
 pair in ``crossview/index.json``.
 
-Match rows are raw (distorted) OpenCV pixels; the truth F/E/H of ``crossview/twoview/i/j.json``
-are for undistorted pixels (x = K (X/Z, Y/Z, 1)), so points of a distorted camera are undistorted
-with the truth camera (``cv2.undistortPoints(..., P=K)``) first: the intrinsics are assumed known,
-as the estimators' users calibrate first.
+Match rows are raw (distorted) OpenCV pixels, read by column name
+(:data:`scenegen.dataset.crossview.MATCH_COLUMNS`); the truth F/E/H of
+``crossview/twoview/i/j.json`` are for undistorted pixels (x = K (X/Z, Y/Z, 1)), so points of a
+distorted camera are undistorted with the truth camera model first
+(:func:`scenegen.geometry.twoview.undistorted_pixels`, its exact inverse): the intrinsics are
+assumed known, as the estimators' users calibrate first.
 
 Raw output per pair and match set: ``<i>__<j>/<set>_F.txt`` (or ``_E.txt``, ``_H.txt``) and
-``<set>_inliers.npy`` (bool mask the estimator returned). Scores (recon_eval.epipolar): inlier
+``<set>_inliers.npy`` (bool mask the estimator returned). Scores (recon_eval.metrics.epipolar): inlier
 precision/recall against the labels (label 0 = inlier), Sampson and symmetric epipolar RMS on
-exact truth correspondences (the dataset's dense visible correspondences), Zhang's F-distance to the
+exact truth correspondences (truth points visible in both views by the dataset's ray-cast
+states, :meth:`DatasetTruth.correspondences`), Zhang's F-distance to the
 truth F, relative pose error via the truth K; for H the mean corner error (MACE) against the plane's
 truth homography, on the matches whose view-i pixel sees that plane.
 """
 from __future__ import annotations
 
-import json
+from typing import Callable
 
+import cv2
 import numpy as np
 
-from recon_eval.runners._common import NotApplicable, RunOutput, crossview_index, out_path
+from recon_eval.errors import NotApplicable
+from recon_eval.metrics.epipolar import (fundamental_metrics, homography_mace, inlier_precision_recall,
+                                         pose_error_from_fundamental, sampson_sq_px2, zhang_f_distance)
+from recon_eval.metrics.poses import relative_pose_errors_deg
+from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from scenegen.geometry.twoview import undistorted_pixels
 
 #: RANSAC-family thresholds, px. FM_RANSAC thresholds the larger point-to-epipolar-line distance
 #: in either image, evaluated on a noisy 7-point model: OpenCV's default (3 px) is used, as a
@@ -42,8 +51,6 @@ MIN_PLANE_MATCHES = 12
 
 
 def _flag(name: str) -> int:
-    import cv2
-
     return {"7point": cv2.FM_7POINT, "8point": cv2.FM_8POINT, "ransac": cv2.FM_RANSAC, "lmeds": cv2.FM_LMEDS,
             "usac_default": cv2.USAC_DEFAULT, "usac_parallel": cv2.USAC_PARALLEL, "usac_fm_8pts": cv2.USAC_FM_8PTS,
             "usac_fast": cv2.USAC_FAST, "usac_accurate": cv2.USAC_ACCURATE, "usac_prosac": cv2.USAC_PROSAC,
@@ -54,31 +61,7 @@ def _thresh(name: str) -> float:
     return USAC_THRESH_PX if name.startswith("usac") else THRESH_PX.get(name, 1.0)
 
 
-def _undistort(cam, x: np.ndarray) -> np.ndarray:
-    """Raw pixels (N, 2) -> undistorted pixels of the same K."""
-    if cam.model == "pinhole" or len(x) == 0:
-        return np.asarray(x, np.float64)
-    n = cam.unproject(np.asarray(x, np.float64))  # (N, 3) on z = 1, the camera's own model
-    return n[:, :2] @ cam.K[:2, :2].T + cam.K[:2, 2]
-
-
-def _pairs(ds):
-    idx = crossview_index(ds)
-    if not idx or not idx.get("pairs"):
-        raise NotApplicable(f"{ds.root}: no cross-view pairs (crossview/index.json: pairs)")
-    return idx["pairs"]
-
-
-def _match_sets(ds, i, j):
-    for kind in ("synthetic", "sift"):
-        p = ds.root / "crossview" / "matches" / i / f"{j}_{kind}.npy"
-        if p.is_file():
-            yield kind, np.load(p)
-
-
 def _fit_f(flag: str, x1, x2):
-    import cv2
-
     if flag in ("7point", "8point"):
         F, mask = cv2.findFundamentalMat(x1, x2, _flag(flag))
     else:
@@ -86,52 +69,46 @@ def _fit_f(flag: str, x1, x2):
     return F, mask
 
 
-def _truth(ds, i, j):
-    tv = json.loads((ds.root / "crossview" / "twoview" / i / f"{j}.json").read_text())
-    return tv
-
-
-def fundamental(ds, out_dir, options) -> RunOutput:
-    from recon_eval.epipolar import (fundamental_metrics, inlier_precision_recall, pose_error_from_fundamental,
-                                     zhang_f_distance)
-
+def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.ndarray] | None = None) -> RunOutput:
+    """cv2.findFundamentalMat with ``options["flag"]`` on every match set of every pair (module
+    docstring). ``transform_F`` maps the estimate before it is written (only
+    :mod:`recon_eval.runners.faults` sets it)."""
     flag = options["flag"]
+    pairs = crossview_pairs(ds)
     out = RunOutput()
-    for pair in _pairs(ds):
-        i, j = pair["i"], pair["j"]
+    for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
-        tv = _truth(ds, i, j)
-        if tv["F"] is None:  # one camera centre (crossview.md): F and E do not exist
+        tv = ds.twoview(i, j)
+        if tv.F is None:  # one camera centre (crossview.md): F and E do not exist
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
-        F_gt = np.asarray(tv["F"], np.float64)
+        F_gt = tv.F
         rel = pj @ pi.inverse()
         t1, t2 = ds.correspondences(i, j, max_points=TRUTH_POINTS)
-        t1, t2 = _undistort(ci, t1), _undistort(cj, t2)
-        for kind, rows in _match_sets(ds, i, j):
-            x1, x2 = _undistort(ci, rows[:, 0:2]), _undistort(cj, rows[:, 2:4])
-            labels = rows[:, 6]
-            use = np.ones(len(rows), bool)
+        t1, t2 = undistorted_pixels(ci, t1), undistorted_pixels(cj, t2)
+        for ms in ds.match_sets(i, j):
+            kind, n = ms.kind, len(ms)
+            x1, x2 = undistorted_pixels(ci, ms.points_i), undistorted_pixels(cj, ms.points_j)
+            true_inl = ms.inliers
+            use = np.ones(n, bool)
             if flag in ("7point", "8point"):  # no robust loop: fed the labelled inliers only
-                use = labels == 0
+                use = true_inl.copy()
             if flag == "7point":  # 7 labelled inliers drawn uniformly (seeded)
                 pick = np.random.default_rng(SEVEN_POINT_SEED).choice(np.flatnonzero(use), 7, replace=False)
-                use = np.zeros(len(rows), bool)
+                use = np.zeros(n, bool)
                 use[pick] = True
             F, mask = _fit_f(flag, x1[use], x2[use])
             if flag == "7point" and F is not None and len(F) > 3:  # up to 3 solutions: keep the one with
                 sols = np.asarray(F).reshape(-1, 3, 3)  # the lowest median Sampson on the labelled inliers
-                from recon_eval.epipolar import sampson_sq_px2
-                inl_all = labels == 0
-                F = min(sols, key=lambda G: float(np.median(sampson_sq_px2(G, x1[inl_all], x2[inl_all]))))
+                F = min(sols, key=lambda G: float(np.median(sampson_sq_px2(G, x1[true_inl], x2[true_inl]))))
             key = f"{i}__{j}.{kind}"
             if F is None or np.asarray(F).shape != (3, 3):
-                F, inl = np.full((3, 3), np.nan), np.zeros(len(rows), bool)
+                F, inl = np.full((3, 3), np.nan), np.zeros(n, bool)
             else:
                 F = np.asarray(F, np.float64)
-                if options.get("transpose"):
-                    F = F.T  # the deliberately broken estimator
-                inl = np.zeros(len(rows), bool)
+                if transform_F is not None:
+                    F = transform_F(F)
+                inl = np.zeros(n, bool)
                 inl[np.flatnonzero(use)] = np.ones(int(use.sum()), bool) if mask is None else mask.ravel() != 0
             fpath = out_path(out_dir, f"{i}__{j}/{kind}_F.txt")
             np.savetxt(fpath, F)
@@ -139,7 +116,7 @@ def fundamental(ds, out_dir, options) -> RunOutput:
             out.raw_files += [f"{i}__{j}/{kind}_F.txt", f"{i}__{j}/{kind}_inliers.npy"]
             F = np.loadtxt(fpath)  # score what was written
             fm = fundamental_metrics(F, t1, t2)
-            ir = inlier_precision_recall(inl, labels == 0)
+            ir = inlier_precision_recall(inl, true_inl)
             zd = zhang_f_distance(F, F_gt, (ci.width, ci.height), (cj.width, cj.height)) if not fm.failed else None
             pe = pose_error_from_fundamental(F, ci.K, cj.K, t1, t2, rel.R, rel.t)
             out.results[f"{key}.fundamental"] = fm
@@ -147,11 +124,11 @@ def fundamental(ds, out_dir, options) -> RunOutput:
             if zd is not None:
                 out.results[f"{key}.zhang_f_distance"] = zd
             out.results[f"{key}.pose_via_K"] = pe
-            pre = f"{kind}." if len(_pairs(ds)) == 1 else f"{key}."
+            pre = f"{kind}." if len(pairs) == 1 else f"{key}."
             out.metrics.update({pre + "sampson_rms_px": fm.sampson_rms_px, pre + "inlier_recall": ir.recall,
                                 pre + "inlier_precision": ir.precision, pre + "pose_err_deg": pe.pose_err_deg})
-            out.notes[f"{key}.matches"] = {"n": int(len(rows)), "used": int(use.sum()),
-                                           "true_inliers": int((labels == 0).sum()),
+            out.notes[f"{key}.matches"] = {"n": int(n), "used": int(use.sum()),
+                                           "true_inliers": int(true_inl.sum()),
                                            "threshold_px": None if flag in ("7point", "8point") else _thresh(flag)}
     if not out.raw_files:
         raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets (or only zero-baseline pairs)")
@@ -159,30 +136,26 @@ def fundamental(ds, out_dir, options) -> RunOutput:
 
 
 def essential(ds, out_dir, options) -> RunOutput:
-    import cv2
-
-    from recon_eval.epipolar import inlier_precision_recall
-    from recon_eval.poses import relative_pose_errors_deg
-
     flag = options["flag"]
     meth = {"ransac": cv2.RANSAC, "lmeds": cv2.LMEDS, "usac_magsac": cv2.USAC_MAGSAC}[flag]
+    pairs = crossview_pairs(ds)
     out = RunOutput()
-    for pair in _pairs(ds):
-        i, j = pair["i"], pair["j"]
+    for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
         rel = pj @ pi.inverse()
-        if _truth(ds, i, j)["E"] is None:
+        if ds.twoview(i, j).E is None:
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
-        for kind, rows in _match_sets(ds, i, j):
+        for ms in ds.match_sets(i, j):
+            kind, n = ms.kind, len(ms)
             # normalised coordinates through each truth camera (the two intrinsics may differ)
-            n1 = ci.unproject(rows[:, 0:2])[:, :2]
-            n2 = cj.unproject(rows[:, 2:4])[:, :2]
+            n1 = ci.unproject(ms.points_i)[:, :2]
+            n2 = cj.unproject(ms.points_j)[:, :2]
             f = 0.5 * (ci.K[0, 0] + cj.K[0, 0])
             E, mask = cv2.findEssentialMat(n1, n2, np.eye(3), meth, CONFIDENCE, _thresh(flag) / f)
             key = f"{i}__{j}.{kind}"
             if E is None or E.shape[0] < 3:
-                E, inl, R, t = np.full((3, 3), np.nan), np.zeros(len(rows), bool), np.full((3, 3), np.nan), np.full(3, np.nan)
+                E, inl, R, t = np.full((3, 3), np.nan), np.zeros(n, bool), np.full((3, 3), np.nan), np.full(3, np.nan)
             else:
                 E = E[:3]
                 inl = mask.ravel() != 0
@@ -195,10 +168,10 @@ def essential(ds, out_dir, options) -> RunOutput:
                                                                          rel.R[None], rel.t[None]))
             else:
                 eR = et = ep = float("inf")
-            ir = inlier_precision_recall(inl, rows[:, 6] == 0)
+            ir = inlier_precision_recall(inl, ms.inliers)
             out.results[f"{key}.inliers"] = ir
             out.results[f"{key}.relative_pose"] = {"rot_err_deg": eR, "trans_dir_err_deg": et, "pose_err_deg": ep}
-            pre = f"{kind}." if len(_pairs(ds)) == 1 else f"{key}."
+            pre = f"{kind}." if len(pairs) == 1 else f"{key}."
             out.metrics.update({pre + "pose_err_deg": ep, pre + "rot_err_deg": eR, pre + "inlier_recall": ir.recall,
                                 pre + "inlier_precision": ir.precision})
     if not out.raw_files:
@@ -207,40 +180,36 @@ def essential(ds, out_dir, options) -> RunOutput:
 
 
 def homography(ds, out_dir, options) -> RunOutput:
-    import cv2
-
-    from recon_eval.epipolar import homography_mace
-
     flag = options["flag"]
     meth = {"ransac": cv2.RANSAC, "usac_magsac": cv2.USAC_MAGSAC}[flag]
+    pairs = crossview_pairs(ds)
     out = RunOutput()
-    for pair in _pairs(ds):
-        i, j = pair["i"], pair["j"]
+    for i, j in pairs:
         ci, _ = ds.camera(i)
         cj, _ = ds.camera(j)
-        planes = _truth(ds, i, j).get("homographies", {})
+        planes = ds.twoview(i, j).homographies
         if not planes:
             continue
-        obj_i = ds._ds.truth(i)["object_id"]
-        names = [o["name"] for o in (ds._ds.spec or {}).get("objects", [])]
-        for kind, rows in _match_sets(ds, i, j):
-            ui = np.clip(np.rint(rows[:, 0]).astype(int), 0, ci.width - 1)
-            vi = np.clip(np.rint(rows[:, 1]).astype(int), 0, ci.height - 1)
+        obj_i = ds.object_ids(i)
+        for ms in ds.match_sets(i, j):
+            kind = ms.kind
+            ui = np.clip(np.rint(ms.column("u_i")).astype(int), 0, ci.width - 1)
+            vi = np.clip(np.rint(ms.column("v_i")).astype(int), 0, ci.height - 1)
             oid = obj_i[vi, ui]
-            for plane, h in planes.items():
-                on = oid == names.index(plane) + 1
+            for plane, H_gt in planes.items():
+                on = oid == ds.object_id(plane)
                 if on.sum() < MIN_PLANE_MATCHES:
                     continue
-                x1, x2 = _undistort(ci, rows[on, 0:2]), _undistort(cj, rows[on, 2:4])
+                x1, x2 = undistorted_pixels(ci, ms.points_i[on]), undistorted_pixels(cj, ms.points_j[on])
                 H, mask = cv2.findHomography(x1, x2, meth, _thresh(flag), maxIters=MAX_ITERS, confidence=CONFIDENCE)
                 H = np.full((3, 3), np.nan) if H is None else H
                 key = f"{i}__{j}.{kind}.{plane}"
                 hp = out_path(out_dir, f"{i}__{j}/{kind}_{plane}_H.txt")
                 np.savetxt(hp, H)
                 out.raw_files.append(f"{i}__{j}/{kind}_{plane}_H.txt")
-                r = homography_mace(np.loadtxt(hp), np.asarray(h["H"]), ci.width, ci.height)
+                r = homography_mace(np.loadtxt(hp), H_gt, ci.width, ci.height)
                 out.results[f"{key}.homography"] = r
-                pre = f"{kind}.{plane}." if len(_pairs(ds)) == 1 else f"{key}."
+                pre = f"{kind}.{plane}." if len(pairs) == 1 else f"{key}."
                 out.metrics[pre + "mace_px"] = r.mace_px
                 out.notes[f"{key}.matches_on_plane"] = int(on.sum())
     if not out.raw_files:

@@ -1,11 +1,297 @@
-"""Fixtures shared by the recon_eval tests."""
+"""Fixtures shared by the recon_eval tests (seeded, small; no Mitsuba).
+
+The analytic plane dataset, written by scenegen's own DatasetWriter. Scene: the plane z = 0 (a
+6 m x 6 m square mesh of two triangles, textured as a checkerboard in the images). Views, 40 x 30 px:
+
+* ``left_000`` and ``right_000``: a rectified stereo rig ("stereo"), identical pinhole cameras
+  (fx = fy = 40, principal point at the image centre) 3 m above the plane looking straight down,
+  the right one displaced by BASELINE_M along the left camera's +x axis;
+* ``free_000``: an OpenCV camera with distortion, oblique, looking at the origin.
+
+Truth per pixel centre = the camera model's own ray intersected with z = 0 (exact up to float32
+storage). Cross-view truth: the correspondence file of every ordered pair of views
+(``crossview/corr/<i>/<j>.exr``), states from :func:`scenegen.crossview.correspondence.correspond`
+with analytic visibility (nothing occludes the plane); no crossview/index.json (the dataset has no
+crossview pairs).
+
+``occluded_plane_dataset``: the rig alone, with a thin wire (radius :data:`WIRE_RADIUS_M`, along
+world y at height :data:`WIRE_HEIGHT_M`) between the cameras and the plane, placed so that it
+crosses no pixel centre's ray of either camera (the depth maps show only the plane) but blocks
+the ray from each camera to one column of the other's truth points (:data:`WIRE_COLUMN`): the
+ray-cast states call those pixels occluded, a depth test at the nearest pixel centre visible.
+"""
+from __future__ import annotations
+
+import types
+
+import numpy as np
 import pytest
+import trimesh
+from scipy.spatial.transform import Rotation
+
+from scenegen import dataset as ds
+from scenegen.crossview.correspondence import correspond
+from scenegen.dataset.codecs import encode_exr
+from scenegen.dataset.crossview import encode_correspondence_channels
+from scenegen.dataset.layout import correspondence_path
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.pose import Rigid3, look_at
+
+W, H = 40, 30
+BASELINE_M = 0.5
+HEIGHT_M = 3.0
+PINHOLE = Camera("pinhole", W, H, 40.0, 40.0, (W - 1) / 2, (H - 1) / 2)
+DISTORTED = Camera("opencv", W, H, 42.0, 41.0, 19.0, 15.0, 0.0, (-0.05, 0.01, 0.001, -0.001, 0.0))
+DOWN = np.diag([1.0, -1.0, -1.0])  # cam_from_world rotation of a camera looking down -z, image x = world x
+#: The wire of the occluded dataset: halfway down, seen 1/3 px from the nearest pixel centre by
+#: both cameras (its half width is 0.1 px there), over left column 25 as seen from the right camera.
+WIRE_HEIGHT_M = 1.5
+WIRE_COLUMN = 25
+# where the ray from the right camera centre to left column WIRE_COLUMN's plane point crosses the height
+WIRE_X_M = BASELINE_M + (1 - WIRE_HEIGHT_M / HEIGHT_M) * ((WIRE_COLUMN - (W - 1) / 2) * HEIGHT_M / PINHOLE.fx - BASELINE_M)
+WIRE_RADIUS_M = 0.1 * (HEIGHT_M - WIRE_HEIGHT_M) / PINHOLE.fx
+
+
+def view_cameras() -> dict:
+    left = Rigid3(DOWN, -DOWN @ np.array([0.0, 0.0, HEIGHT_M]))
+    right = Rigid3(DOWN, -DOWN @ np.array([BASELINE_M, 0.0, HEIGHT_M]))
+    free = look_at((1.0, -1.5, 2.5), (0.2, 0.1, 0.0)).inverse()
+    return {
+        "left_000": ds.ViewCamera(PINHOLE, left, "left", rig="stereo", rig_member="left", frame_index=0),
+        "right_000": ds.ViewCamera(PINHOLE, right, "right", rig="stereo", rig_member="right", frame_index=0),
+        "free_000": ds.ViewCamera(DISTORTED, free, "free", frame_index=0),
+    }
+
+
+def plane_truth(cam: Camera, pose: Rigid3) -> dict:
+    uv = np.stack(np.meshgrid(np.arange(W, dtype=float), np.arange(H, dtype=float)), -1).reshape(-1, 2)
+    d_cam = cam.unproject_unit(uv)
+    world_from_cam = pose.inverse()
+    c = world_from_cam.t
+    d = d_cam @ world_from_cam.R.T
+    s = -c[2] / d[:, 2]
+    P = c + s[:, None] * d
+    Pc = pose.apply(P)
+    valid = (s > 0) & np.all(np.abs(P[:, :2]) < 3.0, axis=1)
+    f = lambda a: a.reshape(H, W, *a.shape[1:]).astype(np.float32)  # noqa: E731
+    t = {"depth_z": f(Pc[:, 2]), "range": f(s), "points_world": f(P), "points_cam": f(Pc),
+         "normals_world": f(np.tile([0.0, 0.0, 1.0], (len(P), 1))), "normals_cam": f(np.tile(pose.R[:, 2], (len(P), 1))),
+         "uv": f(np.zeros((len(P), 2))), "object_id": np.ones((H, W), np.uint32),
+         "instance_id": np.ones((H, W), np.uint32), "valid": valid.reshape(H, W)}
+    miss = ~t["valid"]
+    for k in ("depth_z", "range"):
+        t[k][miss] = np.inf
+    for k in ("points_world", "points_cam", "normals_world", "normals_cam", "uv"):
+        t[k][miss] = np.nan
+    t["object_id"][miss] = 0
+    t["instance_id"][miss] = 0
+    return t
+
+
+def checker_image(truth: dict) -> np.ndarray:
+    P = np.nan_to_num(truth["points_world"])
+    g = ((np.floor(P[..., 0] / 0.25) + np.floor(P[..., 1] / 0.25)) % 2) * 150 + 60
+    g[~truth["valid"]] = 0
+    return np.repeat(g[..., None], 3, axis=2).astype(np.uint8)
+
+
+def nothing_occludes(center, points) -> np.ndarray:
+    """Analytic visibility on the plane: every camera is above it, nothing in between."""
+    return np.ones(len(points), bool)
+
+
+def wire_visibility(center, points) -> np.ndarray:
+    """Analytic visibility with the wire: the segment center -> point misses the wire's axis (a
+    line along y) by more than its radius (2D distance in the x-z plane)."""
+    a = np.array([center[0], center[2]])
+    b = np.asarray(points, float)[:, [0, 2]]
+    q = np.array([WIRE_X_M, WIRE_HEIGHT_M])
+    ab = b - a
+    s = np.clip(((q - a) @ ab.T) / np.sum(ab * ab, axis=1), 0.0, 1.0)
+    dist = np.linalg.norm(a + s[:, None] * ab - q, axis=1)
+    return dist > WIRE_RADIUS_M
+
+
+def write_plane_dataset(root, *, views=None, visible_fn=nothing_occludes, corr_pairs=None) -> dict:
+    """Write the dataset at ``root`` (all views, or the named ones; the correspondence files of every
+    ordered pair, or of ``corr_pairs``); return {view: (Camera, cam_from_world)}."""
+    w = ds.DatasetWriter(root, spec_sha256="cd" * 32, seed=1, variant="test", versions={"numpy": "x"})
+    vcs = {n: vc for n, vc in view_cameras().items() if views is None or n in views}
+    w.write_cameras(vcs, {"objects": [{"name": "plane"}]})
+    w.write_mesh("plane", trimesh.Trimesh([[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], [[0, 1, 2], [0, 2, 3]],
+                                          process=False))
+    truths = {}
+    for name, vc in vcs.items():
+        t = truths[name] = plane_truth(vc.camera, vc.cam_from_world)
+        img = checker_image(t)
+        w.write_view(name, image=img, linear_rgb=img.astype(np.float32) / 255, truth=t)
+    for i in vcs:
+        for j in vcs:
+            if i != j and (corr_pairs is None or (i, j) in corr_pairs):
+                c = correspond(truths[i]["points_world"], vcs[j].camera, vcs[j].cam_from_world, visible_fn)
+                w.write_file(correspondence_path(i, j), encode_exr(encode_correspondence_channels(c)))
+    return {n: (vc.camera, vc.cam_from_world) for n, vc in vcs.items()}
 
 
 @pytest.fixture(scope="session")
 def plane_dataset(tmp_path_factory):
     """(path, {view: (Camera, cam_from_world)}) of the analytic plane dataset (written once)."""
-    from _recon_eval_dataset import write_plane_dataset
-
     root = tmp_path_factory.mktemp("plane") / "ds"
     return root, write_plane_dataset(root)
+
+
+@pytest.fixture(scope="session")
+def occluded_plane_dataset(tmp_path_factory):
+    """(path, {view: (Camera, cam_from_world)}) of the stereo rig over the plane with the wire."""
+    root = tmp_path_factory.mktemp("wire") / "ds"
+    return root, write_plane_dataset(root, views=("left_000", "right_000"), visible_fn=wire_visibility)
+
+
+@pytest.fixture(scope="session")
+def write_plane():
+    """``write_plane(root, views=None, visible_fn=..., corr_pairs=None)``: write a variant of the plane dataset."""
+    return write_plane_dataset
+
+
+@pytest.fixture(scope="session")
+def plane_scene():
+    """The plane dataset's constants: W, H, BASELINE_M, HEIGHT_M, PINHOLE, DISTORTED, the wire's."""
+    return types.SimpleNamespace(W=W, H=H, BASELINE_M=BASELINE_M, HEIGHT_M=HEIGHT_M, PINHOLE=PINHOLE,
+                                 DISTORTED=DISTORTED, WIRE_COLUMN=WIRE_COLUMN, WIRE_X_M=WIRE_X_M,
+                                 WIRE_HEIGHT_M=WIRE_HEIGHT_M, WIRE_RADIUS_M=WIRE_RADIUS_M)
+
+
+# --- small geometry helpers, as fixtures returning the function ------------------------------------
+def _random_rotation(rng: np.random.Generator) -> np.ndarray:
+    return Rotation.random(random_state=rng.integers(1 << 31)).as_matrix()
+
+
+def _look_at_cam_from_world(center, target=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0)):
+    """cam_from_world (R, t) of an OpenCV camera at ``center`` looking at ``target``."""
+    c = np.asarray(center, float)
+    z = np.asarray(target, float) - c
+    z /= np.linalg.norm(z)
+    x = np.cross(z, up)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    R = np.stack([x, y, z])  # rows: camera axes in world
+    return R, -R @ c
+
+
+def _ring_of_cameras(n: int = 8, radius: float = 3.0, height: float = 1.0):
+    """n cameras on a circle looking at the origin: (R (n,3,3), t (n,3)), cam_from_world."""
+    Rs, ts = [], []
+    for k in range(n):
+        a = 2 * np.pi * k / n
+        R, t = _look_at_cam_from_world([radius * np.cos(a), radius * np.sin(a), height + 0.1 * k])
+        Rs.append(R)
+        ts.append(t)
+    return np.array(Rs), np.array(ts)
+
+
+def _num(values) -> str:
+    return " ".join(f"{float(v):.17g}" for v in values)
+
+
+def _write_colmap(d, qs, ts):
+    d.mkdir()
+    (d / "cameras.txt").write_text("# cams\n1 PINHOLE 640 480 500 505 320 240\n")
+    lines = ["# images"]
+    for k, (q, t) in enumerate(zip(qs, ts), start=1):
+        lines.append(f"{k} {_num(q)} {_num(t)} 1 img{k}.png")
+        lines.append("" if k % 2 else "100.0 200.0 -1 5.0 6.0 1")
+    (d / "images.txt").write_text("\n".join(lines) + "\n")
+    # point 1 is observed by image 2's second keypoint (its POINTS2D line references point 1)
+    (d / "points3D.txt").write_text("# pts\n1 0.1 0.2 3.0 255 0 0 0.5 2 1\n")
+
+
+def _write_feature_result(root, kps: dict, matches: dict):
+    """Keypoints and matches in the documented text format (float64 written exactly)."""
+    (root / "keypoints").mkdir(parents=True, exist_ok=True)
+    (root / "matches").mkdir(parents=True, exist_ok=True)
+    for v, xy in kps.items():
+        np.savetxt(root / "keypoints" / f"{v}.txt", xy, fmt="%.17g", header="x y")
+    for (i, j), m in matches.items():
+        np.savetxt(root / "matches" / f"{i}__{j}.txt", m, fmt="%d")
+    return root
+
+
+@pytest.fixture(scope="session")
+def write_feature_result():
+    """``write_feature_result(root, {view: (N, 2)}, {(i, j): (M, 2)})``: a feature result folder."""
+    return _write_feature_result
+
+
+@pytest.fixture(scope="session")
+def random_rotation():
+    """``random_rotation(rng)``: a uniformly random (3, 3) rotation."""
+    return _random_rotation
+
+
+@pytest.fixture(scope="session")
+def look_at_cam_from_world():
+    """``look_at_cam_from_world(center, target=0, up=+z)``: (R, t) cam_from_world, OpenCV axes."""
+    return _look_at_cam_from_world
+
+
+@pytest.fixture(scope="session")
+def ring_of_cameras():
+    """``ring_of_cameras(n=8, radius=3, height=1)``: (R (n, 3, 3), t (n, 3)) looking at the origin."""
+    return _ring_of_cameras
+
+
+@pytest.fixture(scope="session")
+def unit_square():
+    """(V (4, 3), F (2, 3)): the unit square in the z = 0 plane as two triangles."""
+    return np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]), np.array([[0, 1, 2], [0, 2, 3]])
+
+
+@pytest.fixture(scope="session")
+def numbers_text():
+    """``numbers_text(values)``: the values as a line of %.17g numbers (lossless text)."""
+    return _num
+
+
+@pytest.fixture(scope="session")
+def write_colmap():
+    """``write_colmap(folder, qs, ts)``: a COLMAP text model (PINHOLE 640x480) with these poses."""
+    return _write_colmap
+
+
+#: A poster and a blob seen from a reference view, the same view rolled about its optical axis
+#: (one camera centre: no epipolar geometry, nothing to triangulate) and a view 0.6 m to the side;
+#: crossview pairs [ref, rolled] and [ref, side] with labelled match sets.
+ZERO_BASELINE_SPEC = """
+name: zero_baseline_runs
+seed: 5
+render: {spp: 4, max_depth: 2}
+objects:
+  - name: poster
+    shape: {type: plane, size: [1.6, 1.2]}
+    transform: {translation: [0, 0.6, 0.7], rotation_deg: [90, 0, 0]}
+    material: {type: diffuse, texture: {type: natural, params: {size_px: 256}}}
+  - name: rock
+    shape: {type: blob, radius: 0.2}
+    transform: {translation: [0.1, 0.1, 0.5]}
+lights:
+  - {type: constant, radiance: 1.0}
+cameras:
+  cam: {size: [120, 90], fx: 100}
+views:
+  - camera: cam
+    look_at:
+      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6]}
+      - {eye: [0, -1.5, 0.8], target: [0, 0.3, 0.6], up: [0.5, 0, 0.866]}
+      - {eye: [0.6, -1.4, 0.9], target: [0, 0.3, 0.6]}
+crossview:
+  pairs: [[cam_0000, cam_0001], [cam_0000, cam_0002]]
+  flow: false
+  targets: false
+  matches: {count: 200, sigma_px: 0.5, outlier_fraction: 0.2, seed: 3}
+"""
+
+
+@pytest.fixture(scope="session")
+def zero_baseline_spec():
+    """A spec (YAML text) with a zero-baseline crossview pair and an ordinary one (renders: Mitsuba)."""
+    return ZERO_BASELINE_SPEC

@@ -1,0 +1,45 @@
+"""``recon-eval leaderboard``: run a set of methods on a set of datasets and tabulate the headline
+metrics (Markdown, JSON, HTML; pages: :mod:`recon_eval.report.leaderboard_page`). A method that
+does not apply to a dataset (no board, no stereo pair...) is skipped and listed as such; a method
+that applies but fails is a row with the error.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from recon_eval import SCHEMA_VERSION, __version__
+from recon_eval.errors import InputError, NotApplicable
+from recon_eval.readers.scenegen_dataset import read_dataset
+from recon_eval.report.document import write_json_atomic
+from recon_eval.report.leaderboard_page import html_page, markdown
+from recon_eval.runners import method, run_method
+
+
+def run_leaderboard(datasets, methods, out_dir, *, log=print) -> dict:
+    for m in methods:
+        method(m)  # unknown names fail before anything runs
+    out = Path(out_dir)
+    runs, skipped = [], []
+    for d in datasets:
+        scene = read_dataset(d).scene_name
+        for m in methods:
+            try:
+                doc = run_method(m, d, out / scene / m)
+            except NotApplicable as exc:
+                skipped.append({"scene": scene, "method": m, "why": str(exc)})
+                continue
+            runs.append(doc)
+            log(f"{scene:24s} {m:28s} {doc['inputs']['seconds']:7.1f} s")
+    return {"schema_version": SCHEMA_VERSION, "recon_eval_version": __version__, "command": "leaderboard",
+            "datasets": [str(d) for d in datasets], "methods": list(methods), "runs": runs, "skipped": skipped}
+
+
+def write_all(doc: dict, out_dir) -> list[Path]:
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(out / "leaderboard.json", doc)
+    (out / "leaderboard.md").write_text(markdown(doc))
+    (out / "leaderboard.html").write_text(html_page(doc))
+    if not doc["runs"]:
+        raise InputError("leaderboard: no method applied to any dataset (see 'skipped' in leaderboard.json)")
+    return [out / "leaderboard.json", out / "leaderboard.md", out / "leaderboard.html"]

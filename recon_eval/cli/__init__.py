@@ -1,0 +1,80 @@
+"""``recon-eval``: one subcommand per metric family (the table: :mod:`recon_eval.cli.registry`).
+A scored command (:mod:`recon_eval.cli.scored`) prints a table; ``--json OUT`` writes the
+versioned JSON report (see :mod:`recon_eval.report.document`); ``--html OUT`` a self-contained
+HTML report with figures (:mod:`recon_eval.report.html`, needs matplotlib). Bad input -> a
+message naming the file and what was expected, exit code 2, no traceback; ``gate``: exit 1 when
+a gate fails.
+
+Wherever it makes sense the truth may be one of our dataset folders (docs/dataset_format.md):
+poses from cameras.json, depth and disparity from the truth EXRs, the GT surface from
+scene/meshes, held-out truth points for calibration and PnP, dense visible correspondences and
+the truth F for fundamental matrices.
+
+Examples::
+
+    recon-eval cloud REC.ply GT.ply --tau 0.01
+    recon-eval cloud REC.ply DATASET_DIR --tau 0.01                   # GT = the dataset's meshes
+    recon-eval poses EST_MODEL_DIR GT_MODEL_DIR --alignment sim3     # COLMAP models (bin or txt)
+    recon-eval poses EST_MODEL_DIR DATASET_DIR                       # matched by image name = view
+    recon-eval poses transforms.json DATASET_DIR                     # NeRF / instant-ngp
+    recon-eval poses est_kitti.txt DATASET_DIR --camera cam0         # KITTI: line i = i-th view
+    recon-eval poses est_tum.txt gt_tum.txt                          # TUM trajectories
+    recon-eval disparity EST.png GT.png --benchmark kitti
+    recon-eval disparity EST.pfm DATASET_DIR --view left_000 --benchmark middlebury
+    recon-eval depth EST.npy GT.npy --alignment median
+    recon-eval depth EST_DIR DATASET_DIR                             # EST_DIR/<view>.npy|.pfm|.exr
+    recon-eval fmatrix F_est.txt --matches matches.npy --f-gt F_gt.txt --size 640 480
+    recon-eval fmatrix F_est.txt --dataset DATASET_DIR --views cam0_000 cam1_000
+    recon-eval homography H_est.txt H_gt.txt --size 640 480
+    recon-eval calibration est.yaml DATASET_DIR --view cam0_000
+    recon-eval pnp pose.json DATASET_DIR --view cam0_000
+    recon-eval features RESULT DATASET                               # docs/features.md
+    recon-eval dlt P.txt DATASET --view obj_0000                     # docs/metrics.md
+    recon-eval run opencv-f-ransac DATASET -o RESULTS                # docs/ci.md
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from recon_eval.cli.registry import BY_NAME, COMMANDS
+from recon_eval.errors import InputError
+
+EXIT_BAD_INPUT = 2
+
+
+def _family(command: str):
+    """The family module of ``command`` (imported on first use: it loads the heavy readers)."""
+    return importlib.import_module(f"recon_eval.cli.{BY_NAME[command].family}")
+
+
+def build_parser(argv=None, *, full: bool = False) -> argparse.ArgumentParser:
+    """The ``recon-eval`` parser. Every command is listed; the arguments are added for the command
+    named in ``argv`` (its family module is imported), or for every command with ``full``."""
+    ap = argparse.ArgumentParser(prog="recon-eval", description="Score 3D-vision results against exact ground truth.")
+    sub = ap.add_subparsers(dest="command", required=True)
+    chosen = next((t for t in (argv or []) if not t.startswith("-")), None)
+    for c in COMMANDS:
+        p = sub.add_parser(c.name, help=c.help, description=c.description or c.help)
+        if full or c.name == chosen:
+            _family(c.name).COMMANDS[c.name].arguments(p)
+    return ap
+
+
+def main(argv=None) -> int:
+    """Run one command; its exit code: 0 ok, 1 a gate failed, 2 bad input (no traceback)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)  # argparse itself exits with code 2 on bad usage
+    try:
+        return _family(args.command).COMMANDS[args.command].run(args)
+    except InputError as exc:
+        print(f"recon-eval: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:  # unreadable input or unwritable output
+        print(f"recon-eval: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,110 @@
+"""``recon-eval calibration`` and ``recon-eval pnp``: a camera's intrinsics, and one view's pose,
+against a dataset's truth camera or truth files (docs/metrics.md, "Calibration and PnP")."""
+from __future__ import annotations
+
+import numpy as np
+
+from recon_eval.cli.common import dataset_view, needs_dataset_for_view
+from recon_eval.cli.scored import no_figures, scored
+from recon_eval.errors import InputError
+from recon_eval.metrics.calibration import intrinsics_errors, projection_difference, reprojection_rms
+from recon_eval.metrics.pnp import pnp_errors
+from recon_eval.readers.npy import read_npy
+from recon_eval.readers.opencv_calib import read_opencv_calibration
+from recon_eval.readers.pose_file import read_pose
+from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
+from recon_eval.report import plots
+from recon_eval.report.html import Figure
+
+
+# --- calibration ------------------------------------------------------------------------------
+def calibration_arguments(p) -> None:
+    p.add_argument("est", help="estimated calibration, OpenCV YAML/JSON (camera_matrix/K, distortion_coefficients/D)")
+    p.add_argument("gt", help="truth: a dataset folder (camera of --view) or an OpenCV YAML/JSON calibration")
+    p.add_argument("--view", help="dataset truth: the view whose camera is the truth (default: the first view)")
+    p.add_argument("--est-model", choices=["opencv", "fisheye"], help="override the estimate's distortion model")
+    p.add_argument("--grid", type=int, nargs=2, default=(60, 40), metavar=("NX", "NY"), help="projection-difference grid")
+    p.add_argument("--points", type=int, default=5000, help="dataset truth: held-out truth points for reprojection")
+
+
+def score_calibration(a):
+    est = read_opencv_calibration(a.est, model=a.est_model)
+    inputs = {"est": a.est, "gt": a.gt, "est_model": est.model}
+    held_out = None
+    if is_dataset(a.gt):
+        ds = read_dataset(a.gt)
+        view = a.view or ds.views[0]
+        gt, pose = ds.camera(view)
+        uv, X = ds.points_at_pixels(view, max_points=a.points)
+        held_out = (pose, X, uv)
+        inputs.update(view=view, gt_kind="scenegen-dataset camera", held_out_points=len(X))
+    else:
+        needs_dataset_for_view(a)
+        gt = read_opencv_calibration(a.gt)
+        inputs["gt_kind"] = "OpenCV calibration file"
+    inputs["gt_model"] = gt.model
+    if (gt.width, gt.height) != (est.width, est.height):
+        raise InputError(f"{a.est}: image_width/image_height {est.width}x{est.height} differ from the truth's "
+                         f"{gt.width}x{gt.height} ({a.gt})")
+    nx, ny = a.grid
+    res = {"intrinsics": intrinsics_errors(est.K, gt.K),
+           "projection_diff": projection_difference(gt, est, grid_nx=nx, grid_ny=ny),
+           "projection_diff_rotation_fitted": projection_difference(gt, est, grid_nx=nx, grid_ny=ny, fit_rotation=True)}
+    if held_out is not None:
+        pose, X, uv = held_out
+        res["reprojection_held_out"] = reprojection_rms(est, pose.R, pose.t, X, uv)
+
+    def figures():
+        figs = []
+        for key, what in (("projection_diff", "intrinsics only"), ("projection_diff_rotation_fitted", "rotation fitted")):
+            r = res[key]
+            figs.append(Figure(f"Projection difference ({what})",
+                               plots.field_figure(r.diff_px, r.grid_u_px, r.grid_v_px, unit="px",
+                                                  title=f"|project_est(unproject_gt(x)) - x|, {what}"),
+                               f"mrcal-style; mean {r.mean_px:.4g} px, max {r.max_px:.4g} px"))
+        return figs
+
+    return inputs, res, figures
+
+
+# --- PnP --------------------------------------------------------------------------------------
+def pnp_arguments(p) -> None:
+    p.add_argument("est", help="estimated pose (.json {R, t} / 3x4 / 4x4, .npy, .txt)")
+    p.add_argument("gt", help="truth: a dataset folder (pose of --view) or a pose file")
+    p.add_argument("--view", help="dataset truth: the view (required when the dataset has several)")
+    p.add_argument("--est-convention", choices=["cam_from_world", "world_from_cam"], default="cam_from_world",
+                   help="what a bare matrix in EST holds (default: OpenCV solvePnP's cam_from_world)")
+    p.add_argument("--gt-convention", choices=["cam_from_world", "world_from_cam"], default="cam_from_world")
+    p.add_argument("--points", type=int, default=5000, help="dataset truth: held-out truth points for reprojection")
+    p.add_argument("--points-world", help="non-dataset truth: (N, 3) .npy world points for reprojection")
+    p.add_argument("--pixels", help="non-dataset truth: (N, 2) .npy pixels observing them")
+    p.add_argument("--calib", help="non-dataset truth: camera for reprojection (OpenCV YAML/JSON)")
+
+
+def score_pnp(a):
+    R_est, t_est = read_pose(a.est, a.est_convention)
+    inputs = {"est": a.est, "gt": a.gt, "est_convention": a.est_convention}
+    cam = X = uv = None
+    if is_dataset(a.gt):
+        ds = read_dataset(a.gt)
+        view = dataset_view(ds, a.view, "a PnP truth")
+        cam, pose = ds.camera(view)
+        R_gt, t_gt = pose.R, pose.t
+        uv, X = ds.points_at_pixels(view, max_points=a.points)
+        inputs.update(view=view, gt_kind="scenegen-dataset cameras.json", held_out_points=len(X))
+    else:
+        needs_dataset_for_view(a)
+        R_gt, t_gt = read_pose(a.gt, a.gt_convention)
+        if not (np.all(np.isfinite(R_gt)) and np.all(np.isfinite(t_gt))):
+            raise InputError(f"{a.gt}: the truth pose has non-finite values")
+        inputs.update(gt_kind="pose file", gt_convention=a.gt_convention)
+        if a.points_world or a.pixels or a.calib:
+            if not (a.points_world and a.pixels and a.calib):
+                raise InputError("reprojection needs all of --points-world, --pixels and --calib")
+            X, uv, cam = read_npy(a.points_world, (None, 3)), read_npy(a.pixels, (None, 2)), read_opencv_calibration(a.calib)
+            if len(X) != len(uv):
+                raise InputError(f"{a.points_world} ({len(X)} points) and {a.pixels} ({len(uv)} pixels) differ in length")
+    return inputs, {"pnp": pnp_errors(R_est, t_est, R_gt, t_gt, cam=cam, points_world=X, pixels=uv)}, no_figures
+
+
+COMMANDS = {"calibration": scored(calibration_arguments, score_calibration), "pnp": scored(pnp_arguments, score_pnp)}

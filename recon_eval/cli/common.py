@@ -1,0 +1,26 @@
+"""Small helpers the command families share: the dataset view a command scores, shape checks."""
+from __future__ import annotations
+
+from recon_eval.errors import InputError
+
+
+def dataset_view(ds, view, where: str) -> str:
+    """``view`` checked against the dataset, or its only view when ``view`` is None (``where``
+    says what needs one, for the error)."""
+    if view is None:
+        if len(ds.views) != 1:
+            raise InputError(f"{ds.root}: {where} needs --view VIEW (complete views: {', '.join(ds.views[:8])}"
+                             f"{' ...' if len(ds.views) > 8 else ''})")
+        return ds.views[0]
+    return ds.check_view(view)
+
+
+def same_shape(est, gt, est_name, gt_name) -> None:
+    if est.shape != gt.shape:
+        raise InputError(f"{est_name}: shape {est.shape} differs from the truth's {gt.shape} ({gt_name})")
+
+
+def needs_dataset_for_view(a) -> None:
+    """``--view`` only names a view of a dataset truth."""
+    if a.view:
+        raise InputError(f"--view needs a dataset truth; {a.gt} is not a dataset folder")

@@ -1,0 +1,145 @@
+"""``recon-eval disparity`` and ``recon-eval depth``: per-pixel maps against a truth map or a
+dataset's truth (docs/metrics.md, "Stereo disparity", "Depth maps"). Map formats:
+:func:`recon_eval.readers.registry.read_map`."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
+from recon_eval.cli.scored import scored
+from recon_eval.errors import InputError
+from recon_eval.metrics.depth import eigen_depth_metrics
+from recon_eval.metrics.stereo import eth3d_two_view, kitti_d1, middlebury
+from recon_eval.readers.kitti_png import read_kitti_obj_map
+from recon_eval.readers.registry import find_view_map, read_map
+from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
+from recon_eval.report import plots
+from recon_eval.report.html import Figure
+
+
+# --- disparity --------------------------------------------------------------------------------
+def disparity_arguments(p) -> None:
+    p.add_argument("est", help="estimated disparity (.png KITTI uint16, .pfm, .npy, .exr)")
+    p.add_argument("gt", help="truth disparity (occ / all pixels), or a dataset folder with --view")
+    p.add_argument("--view", help="dataset truth: the left view of a rectified stereo pair")
+    p.add_argument("--right-view", help="dataset truth: its right view (default: the other member of the rig)")
+    p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr)")
+    p.add_argument("--obj-map", help="KITTI foreground map PNG")
+    p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti")
+
+
+def score_disparity(a):
+    est = read_map(a.est, "disparity")
+    gt_kind = "file"
+    if is_dataset(a.gt):
+        ds = read_dataset(a.gt)
+        view = dataset_view(ds, a.view, "a disparity truth")
+        gt = ds.disparity(view, a.right_view)
+        gt_kind = f"scenegen-dataset view {view}: fx * baseline / depth_z"
+    else:
+        needs_dataset_for_view(a)
+        gt = read_map(a.gt, "disparity")
+    same_shape(est, gt, a.est, a.gt)
+    noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    if a.benchmark == "kitti":
+        obj = [read_kitti_obj_map(a.obj_map)] if a.obj_map else None
+        res = {"kitti_d1": kitti_d1([est], [gt], None if noc is None else [noc], obj)}
+    else:
+        mask = None if noc is None else np.isfinite(noc)
+        fn = middlebury if a.benchmark == "middlebury" else eth3d_two_view
+        res = {a.benchmark: fn(est, gt, mask)}
+    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
+              "benchmark": a.benchmark}
+
+    def figures():
+        e = np.abs(est - gt)
+        e = e[np.isfinite(gt)]
+        return [
+            Figure("Disparity error", plots.map_error_figure(est, gt, title="disparity", unit="px", error_clip=6.0),
+                   "error colour scale capped at 6 px (twice KITTI's 3 px)"),
+            Figure("Cumulative disparity error",
+                   plots.cumulative_figure({"|d - d*| over truth pixels": e}, xlabel="disparity error (px)",
+                                           title="cumulative error (missing estimates count as failures)",
+                                           thresholds=(0.5, 1.0, 2.0, 3.0, 4.0), xmax=8.0)),
+        ]
+
+    return inputs, res, figures
+
+
+# --- depth ------------------------------------------------------------------------------------
+def depth_arguments(p) -> None:
+    p.add_argument("est", help="predicted z-depth (.npy, .pfm, .exr), metres; with a dataset truth also a folder "
+                               "of <view>.npy|.pfm|.exr (a view without a file is a failed image)")
+    p.add_argument("gt", help="truth depth (.npy, .pfm, .exr), metres, or a dataset folder (truth/<view>.exr depth_z)")
+    p.add_argument("--view", action="append", help="dataset truth: view(s) to score (default: all; a single "
+                                                   "estimate file needs exactly one)")
+    p.add_argument("--alignment", choices=["none", "median", "scale_shift"], default="none")
+    p.add_argument("--min-depth", type=float, default=0.0)
+    p.add_argument("--max-depth", type=float, default=float("inf"))
+
+
+def _dataset_depths(a, ds):
+    """(estimates, truths, views without an estimate, view names) against a dataset truth."""
+    if Path(a.est).is_dir():
+        views = a.view or list(ds.views)
+        for v in views:
+            ds.check_view(v)
+        est_list, missing = [], []
+        gt_list = [ds.depth(v) for v in views]
+        for v, g in zip(views, gt_list):
+            f = find_view_map(a.est, v)
+            if f is None:
+                missing.append(v)
+                est_list.append(np.full_like(g, np.nan))
+            else:
+                est_list.append(read_map(str(f), "depth"))
+                same_shape(est_list[-1], g, f, f"{a.gt} view {v}")
+        return est_list, gt_list, missing, list(views)
+    if a.view and len(a.view) > 1:
+        raise InputError(f"{a.est}: one estimate file scores one view; pass a folder of <view> files for several")
+    v = dataset_view(ds, a.view[0] if a.view else None, "a single depth estimate")
+    est_list, gt_list = [read_map(a.est, "depth")], [ds.depth(v)]
+    same_shape(est_list[0], gt_list[0], a.est, f"{a.gt} view {v}")
+    return est_list, gt_list, [], [v]
+
+
+def score_depth(a):
+    names = None
+    if is_dataset(a.gt):
+        est_list, gt_list, missing, names = _dataset_depths(a, read_dataset(a.gt))
+        gt_kind = "scenegen-dataset truth/<view>.exr depth_z"
+    else:
+        needs_dataset_for_view(a)
+        est_list, gt_list, missing, gt_kind = [read_map(a.est, "depth")], [read_map(a.gt, "depth")], [], "file"
+        same_shape(est_list[0], gt_list[0], a.est, a.gt)
+    res = {"eigen": eigen_depth_metrics(est_list, gt_list, alignment=a.alignment,
+                                        min_depth_m=a.min_depth, max_depth_m=a.max_depth)}
+    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "views": names, "views_without_estimate": missing,
+              "alignment": a.alignment}
+
+    def figures():
+        r = res["eigen"]
+        figs, rel = [], {}
+        for k, (e, g) in enumerate(zip(est_list, gt_list)):
+            e_al = r.per_image_scale[k] * e + r.per_image_shift_m[k]
+            label = names[k] if names else Path(a.est).name
+            if k < 8:
+                figs.append(Figure(f"Depth error: {label}",
+                                   plots.map_error_figure(e_al, g, title=f"{label} (alignment {a.alignment})", unit="m")))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                ok = np.isfinite(g) & (g > a.min_depth) & (g < a.max_depth)
+                rel[label] = np.where(np.isfinite(e_al[ok]) & (e_al[ok] > 0), np.abs(e_al[ok] - g[ok]) / g[ok], np.inf)
+        if len(rel) > 6:
+            rel = {"all images": np.concatenate(list(rel.values()))}
+        figs.append(Figure("Cumulative relative depth error",
+                           plots.cumulative_figure(rel, xlabel="|p - g| / g", title="cumulative abs_rel per pixel",
+                                                   thresholds=(0.25,), xmax=0.5),
+                           "missing predictions count as failures; 0.25 = a1's ratio bound"))
+        return figs
+
+    return inputs, res, figures
+
+
+COMMANDS = {"disparity": scored(disparity_arguments, score_disparity), "depth": scored(depth_arguments, score_depth)}

@@ -1,0 +1,92 @@
+"""``recon-eval poses``: estimated camera poses against the truth, any pair of pose sources the
+readers registry sniffs (:func:`recon_eval.readers.registry.read_poses`; docs/metrics.md,
+"Camera poses")."""
+from __future__ import annotations
+
+from pathlib import PurePosixPath
+
+from recon_eval.cli.scored import scored
+from recon_eval.errors import InputError
+from recon_eval.metrics.align import Alignment
+from recon_eval.metrics.poses import Poses, ape, relative_pose, rpe
+from recon_eval.readers.registry import read_poses
+from recon_eval.readers.tum import associate
+from recon_eval.report import plots
+from recon_eval.report.html import Figure
+
+
+def arguments(p) -> None:
+    p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM or KITTI odometry trajectory, or a dataset")
+    p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file")
+    p.add_argument("--alignment", choices=["none", "se3", "sim3"], default="sim3")
+    p.add_argument("--delta", type=int, default=1, help="RPE frame offset")
+    p.add_argument("--max-time-diff", type=float, default=0.01, help="TUM timestamp association, seconds")
+    p.add_argument("--camera", help="dataset truth: only the views of this spec camera (e.g. the left camera of a "
+                                    "KITTI-style trajectory)")
+    p.add_argument("--kitti-convention", choices=["world_from_cam", "cam_from_world"], default="world_from_cam",
+                   help="what a KITTI line holds (KITTI odometry: world_from_cam of the left camera)")
+
+
+def match_names_by_stem(est: Poses, gt: Poses) -> tuple[Poses, bool]:
+    """Rename estimated poses whose name is not a truth name but whose file name, or file name
+    without its extension, is (COLMAP ``images/cam0_000.png`` -> view ``cam0_000``)."""
+    truth, names, renamed = set(gt.names), [], False
+    for n in est.names:
+        if n not in truth:
+            base = PurePosixPath(n.replace("\\", "/")).name
+            for cand in (base, base.rsplit(".", 1)[0]):
+                if cand in truth:
+                    n, renamed = cand, True
+                    break
+        names.append(n)
+    return (Poses(tuple(names), est.R_cam_from_world, est.t_cam_from_world) if renamed else est), renamed
+
+
+def score(a):
+    ek, est = read_poses(a.est, camera=a.camera, kitti_convention=a.kitti_convention)
+    gk, gt = read_poses(a.gt, camera=a.camera, kitti_convention=a.kitti_convention)
+    matching = "by name"
+    if (ek == "tum") != (gk == "tum"):
+        raise InputError(f"{a.est if ek == 'tum' else a.gt}: a TUM trajectory is matched by timestamps and needs a "
+                         "TUM trajectory on the other side")
+    if ek == "tum":
+        est, gt = associate(est, gt, a.max_time_diff), gt.poses
+        matching = f"TUM timestamps within {a.max_time_diff} s"
+    elif ek == "kitti" and gk != "kitti":
+        # KITTI lines carry no names: line i is the i-th truth pose in truth order
+        n = min(len(est.names), len(gt.names))  # lines beyond the truth keep their own names: n_extra
+        est = Poses(gt.names[:n] + est.names[n:], est.R_cam_from_world, est.t_cam_from_world)
+        matching = "KITTI line i = i-th truth view"
+    else:
+        est, renamed = match_names_by_stem(est, gt)
+        if renamed:
+            matching = "by name (folders and image extensions ignored where needed)"
+    if len(gt.names) == 0:
+        raise InputError(f"{a.gt}: the truth has no poses")
+    al = Alignment(a.alignment)
+    res = {"ape": ape(est, gt, alignment=al), "rpe": rpe(est, gt, delta_frames=a.delta, alignment=al),
+           "relative_pose": relative_pose(est, gt)}
+    inputs = {"est": a.est, "gt": a.gt, "format": ek, "gt_format": gk, "matching": matching,
+              "alignment": a.alignment, "delta_frames": a.delta, "camera": a.camera,
+              "kitti_convention": a.kitti_convention if "kitti" in (ek, gk) else None}
+
+    def figures():
+        r, rp = res["ape"], res["relative_pose"]
+        return [
+            Figure("Per-camera pose errors", plots.per_camera_figure(r.names, r.trans_err_m, r.rot_err_deg,
+                                                                     title=f"APE after {a.alignment} alignment")),
+            Figure("Cumulative APE", plots.cumulative_figure({"rotation (deg)": r.rot_err_deg},
+                                                             xlabel="rotation error (deg)", title="APE rotation")),
+            Figure("Cumulative APE translation", plots.cumulative_figure({"translation (m)": r.trans_err_m},
+                                                                         xlabel="translation error (m)",
+                                                                         title="APE translation")),
+            Figure("Cumulative relative pose error",
+                   plots.cumulative_figure({"max(rot, trans dir)": rp.pose_err_deg}, xlabel="pose error (deg)",
+                                           title="relative pose (AUC thresholds 5/10/20 deg)",
+                                           thresholds=(5.0, 10.0, 20.0), xmax=30.0)),
+        ]
+
+    return inputs, res, figures
+
+
+COMMANDS = {"poses": scored(arguments, score)}

@@ -1,0 +1,55 @@
+"""The one table of ``recon-eval`` subcommands: name, help, and the family module that implements
+it. This module imports nothing heavy, so ``recon-eval --help`` lists every command without
+loading numpy, OpenCV or the dataset reader; a family module is imported only for its own commands.
+
+Every family module (``recon_eval.cli.<family>``) registers its commands the same way: a dict
+``COMMANDS`` of command name -> :class:`Impl` (a function adding the command's arguments to its
+parser, and ``run(args) -> exit code``). Scored commands, which write recon_eval's versioned
+report, are built by :func:`recon_eval.cli.scored.scored` around a function returning
+``(inputs, results, figures)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+
+@dataclass(frozen=True)
+class Command:
+    name: str
+    help: str
+    family: str  # the module recon_eval.cli.<family> that implements it
+    description: str = ""  # the command's --help text, when it says more than ``help``
+
+
+@dataclass(frozen=True)
+class Impl:
+    """A family module's implementation of one command."""
+
+    arguments: Callable  # (argparse.ArgumentParser) -> None
+    run: Callable  # (argparse.Namespace) -> exit code (0 ok, 1 a gate failed; bad input raises InputError)
+
+
+COMMANDS: tuple[Command, ...] = (
+    Command("cloud", "point cloud / mesh: Tanks and Temples, ETH3D, DTU, Chamfer", "cloud"),
+    Command("poses", "camera poses: APE, RPE, registration ratio, relative-pose AUC and mAA", "poses"),
+    Command("disparity", "stereo disparity: KITTI D1, Middlebury, ETH3D two-view", "maps"),
+    Command("depth", "depth maps: Eigen abs_rel, sq_rel, rmse, rmse_log, a1..a3", "maps"),
+    Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
+    Command("homography", "homography: mean corner error, accuracy and AUC", "twoview"),
+    Command("calibration", "intrinsics: fx/fy/cx/cy errors, projection difference field, reprojection RMS", "camera"),
+    Command("pnp", "absolute pose: rotation angle, translation error, reprojection RMS", "camera"),
+    Command("features", "keypoints and matches: repeatability, MMA@1..10, matching score, precision and recall "
+                        "per image pair and series", "features"),
+    Command("dlt", "DLT camera matrix: RQ into K, R, t; intrinsics, pose and reprojection errors", "geometry"),
+    Command("triangulation-task", "write a triangulation task: camera pairs with noisy truth correspondences",
+            "geometry"),
+    Command("triangulation", "triangulated points against the truth, binned by triangulation angle", "geometry"),
+    Command("run", "run an estimator on a dataset, keep its raw output, score it", "ci",
+            description="Run METHOD on DATASET; raw output and result.json go to -o RESULTS."),
+    Command("leaderboard", "run methods on datasets; write leaderboard.md/.json/.html", "ci",
+            description="Run every METHOD on every DATASET (inapplicable pairs are skipped)."),
+    Command("gate", "check run results against a gate file (exit 1 when any gate fails)", "ci",
+            description="Check results against GATES; exit 0 all hold, 1 any fails, 2 bad input."),
+)
+BY_NAME: dict[str, Command] = {c.name: c for c in COMMANDS}

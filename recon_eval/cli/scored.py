@@ -1,0 +1,45 @@
+"""Scored commands: the ones that write recon_eval's versioned report. Each is a function
+``score(args) -> (inputs, results, figures)`` (provenance, metric name -> result dataclass, and a
+function returning the HTML :class:`recon_eval.report.html.Figure` list, called only for
+``--html``); :func:`scored` makes it a command that prints the table and writes ``--json`` and
+``--html``."""
+from __future__ import annotations
+
+from typing import Callable
+
+from recon_eval.cli.registry import Impl
+from recon_eval.errors import InputError
+from recon_eval.report.document import document, print_table, write_json_atomic
+from recon_eval.report.html import render_html, write_html_atomic
+
+
+def no_figures() -> list:
+    return []
+
+
+def scored(arguments: Callable, score: Callable) -> Impl:
+    """The :class:`Impl` of a scored command: ``--json``, ``--html`` and ``--quiet``, then the
+    command's own ``arguments(parser)``; running it calls ``score(args)`` and reports."""
+
+    def add(p) -> None:
+        p.add_argument("--json", metavar="OUT", help="write the JSON report here (atomically)")
+        p.add_argument("--html", metavar="OUT",
+                       help="write a self-contained HTML report with figures (needs matplotlib)")
+        p.add_argument("--quiet", action="store_true", help="do not print the table")
+        arguments(p)
+
+    def run(a) -> int:
+        inputs, results, figures = score(a)
+        if not a.quiet:
+            print_table(f"recon-eval {a.command}", results)
+        if a.json:
+            write_json_atomic(a.json, document(a.command, inputs, results))
+        if a.html:
+            try:
+                import matplotlib  # noqa: F401  (optional: only the HTML report's figures need it)
+            except ImportError:
+                raise InputError("--html needs matplotlib (pip install matplotlib)") from None
+            write_html_atomic(a.html, render_html(a.command, inputs, results, figures()))
+        return 0
+
+    return Impl(add, run)

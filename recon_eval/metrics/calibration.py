@@ -1,0 +1,140 @@
+"""Calibration metrics: intrinsic parameter errors, the mrcal-style projection difference field,
+and reprojection RMS on held-out truth points.
+
+Definitions: shared/notes/metrics.md, "Calibration and PnP". Distortion coefficients are not
+compared one by one (they are correlated; OpenCV's own test leaves that check commented out):
+the projection difference field compares what the models *do*, across model families.
+
+Camera objects are duck-typed (``scenegen.geometry.camera.Camera`` satisfies it): ``width``, ``height``,
+``K`` (3, 3), ``project(points_cam (N, 3)) -> (N, 2)`` pixels (NaN where invalid), and
+``unproject(pixels (N, 2)) -> (N, 3)`` points on z = 1 (NaN where invalid); ``unproject_unit``
+(unit rays) is used when present so rays beyond 90 degrees (fisheye) are compared too.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from recon_eval.arrays import as_float_array, frozen
+from recon_eval.errors import InputError
+from scenegen.geometry.rotation import matrix_from_rotvec, rotation_angle_rad
+
+
+@dataclass(frozen=True)
+class IntrinsicsResult:
+    """Errors of fx, fy, cx, cy: absolute in pixels, relative to the truth value (OpenCV's
+    calibration test compares relative errors to eps 1e-2)."""
+
+    fx_abs_err_px: float
+    fy_abs_err_px: float
+    cx_abs_err_px: float
+    cy_abs_err_px: float
+    fx_rel_err: float  # |fx_est - fx_gt| / |fx_gt|
+    fy_rel_err: float
+    cx_rel_err: float
+    cy_rel_err: float
+
+
+def intrinsics_errors(K_est, K_gt) -> IntrinsicsResult:
+    """fx, fy, cx, cy errors from (3, 3) camera matrices (OpenCV pixel convention)."""
+    Ke = as_float_array(K_est, "K_est", (3, 3))
+    Kg = as_float_array(K_gt, "K_gt", (3, 3))
+    idx = ((0, 0), (1, 1), (0, 2), (1, 2))
+    ab = [abs(Ke[i] - Kg[i]) for i in idx]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = [float(a / abs(Kg[i])) for a, i in zip(ab, idx)]
+    return IntrinsicsResult(*(float(a) for a in ab), *rel)
+
+
+@dataclass(frozen=True)
+class ProjectionDiffResult:
+    """Projection difference field of two camera models over a pixel grid (mrcal
+    ``projection_diff``)."""
+
+    mean_px: float  # over valid grid points
+    max_px: float
+    rms_px: float
+    diff_px: np.ndarray  # (ny, nx) per-grid-point difference, NaN where invalid
+    grid_u_px: np.ndarray  # (nx,) column coordinates of the grid (OpenCV pixels)
+    grid_v_px: np.ndarray  # (ny,)
+    valid_frac: float  # grid points where both unprojection and projection are defined
+    rotation_fitted: bool  # False: intrinsics only (identity transform, mrcal intrinsics_only)
+    fitted_rot_deg: float  # angle of the fitted rotation (0 when not fitted)
+
+
+def _rays(cam, uv: np.ndarray) -> np.ndarray:
+    if hasattr(cam, "unproject_unit"):
+        return np.asarray(cam.unproject_unit(uv), dtype=np.float64)
+    return np.asarray(cam.unproject(uv), dtype=np.float64)
+
+
+def projection_difference(cam_gt, cam_est, *, grid_nx: int = 60, grid_ny: int = 40,
+                          fit_rotation: bool = False) -> ProjectionDiffResult:
+    """mrcal-style projection difference (mrcal ``projection_diff``): grid the image (pixel
+    centres spanning [0, W-1] x [0, H-1], ``grid_nx`` x ``grid_ny``), unproject every grid pixel
+    with the truth camera, project the ray with the estimated camera, and take the pixel distance
+    to the grid pixel. ``fit_rotation=False`` is mrcal's ``intrinsics_only`` (identity transform).
+    With ``fit_rotation=True`` the rotation R minimising the sum of squared differences of
+    ``project_est(R ray)`` is fitted first (scipy least squares; a rotation is what an intrinsics
+    difference can trade against at infinity), and the residual field reported.
+    Valid for any pair of model families. Grid points where either model is undefined are NaN in
+    the field and excluded from the statistics (``valid_frac`` says how many remain).
+    """
+    if (cam_gt.width, cam_gt.height) != (cam_est.width, cam_est.height):
+        raise InputError(f"cameras differ in image size: {(cam_gt.width, cam_gt.height)} vs {(cam_est.width, cam_est.height)}")
+    gu = np.linspace(0.0, cam_gt.width - 1.0, grid_nx)
+    gv = np.linspace(0.0, cam_gt.height - 1.0, grid_ny)
+    U, V = np.meshgrid(gu, gv)
+    uv = np.stack([U.ravel(), V.ravel()], axis=1)  # (ny*nx, 2)
+    rays = _rays(cam_gt, uv)  # (M, 3)
+    ok = np.all(np.isfinite(rays), axis=1)
+    R = np.eye(3)
+    if fit_rotation:
+        from scipy.optimize import least_squares  # heavy, and only the rotation-fitted variant needs it
+
+        def resid(w):
+            p = np.asarray(cam_est.project(rays[ok] @ matrix_from_rotvec(w).T), float)
+            r = p - uv[ok]
+            return np.where(np.isfinite(r), r, 0.0).ravel()
+
+        w = least_squares(resid, np.zeros(3), x_scale=1e-3).x
+        R = matrix_from_rotvec(w)
+    proj = np.full_like(uv, np.nan)
+    proj[ok] = np.asarray(cam_est.project(rays[ok] @ R.T), dtype=np.float64)
+    d = np.linalg.norm(proj - uv, axis=1)
+    valid = np.isfinite(d)
+    dv = d[valid]
+    nan = float("nan")
+    return ProjectionDiffResult(
+        float(np.mean(dv)) if len(dv) else nan, float(np.max(dv)) if len(dv) else nan,
+        float(np.sqrt(np.mean(dv**2))) if len(dv) else nan,
+        frozen(d.reshape(grid_ny, grid_nx)), frozen(gu), frozen(gv), float(np.mean(valid)),
+        fit_rotation, float(np.degrees(rotation_angle_rad(R))),
+    )
+
+
+@dataclass(frozen=True)
+class ReprojectionResult:
+    rms_px: float  # sqrt(mean |project(R X + t) - x|^2) over the points; inf if any is unprojectable
+    median_px: float
+    max_px: float
+    n_points: int
+    n_invalid: int  # points the camera could not project (behind it, outside its model): failures
+
+
+def reprojection_rms(cam, R_cam_from_world, t_cam_from_world, points_world, pixels) -> ReprojectionResult:
+    """Reprojection error of held-out truth points (N, 3) metres observed at ``pixels`` (N, 2)
+    through ``cam`` at pose cam_from_world (R (3, 3), t (3,)). Points that do not project are
+    failures: they make rms/max inf and are counted."""
+    X = as_float_array(points_world, "points_world", (None, 3))
+    x = as_float_array(pixels, "pixels", (len(X), 2))
+    R = as_float_array(R_cam_from_world, "R_cam_from_world", (3, 3))
+    t = as_float_array(t_cam_from_world, "t_cam_from_world", (3,))
+    if len(X) == 0:
+        raise InputError("reprojection_rms: no points")
+    p = np.asarray(cam.project(X @ R.T + t), dtype=np.float64)
+    e = np.linalg.norm(p - x, axis=1)
+    bad = ~np.isfinite(e)
+    e[bad] = np.inf
+    return ReprojectionResult(float(np.sqrt(np.mean(e**2))), float(np.median(e)), float(np.max(e)), len(X), int(bad.sum()))
