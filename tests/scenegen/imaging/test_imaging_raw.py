@@ -1,8 +1,8 @@
 """The raw mosaic and the ISP after it (issue 19), without rendering.
 
 * The delivered image is reproduced to the last DN from the raw mosaic by the recorded ISP
-  stages, run by an independent implementation of the documented steps (OpenCV and numpy only,
-  reading the JSON record: the ``develop_from_record`` fixture), for every preset and ISP option.
+  stages, run by the code docs/image_formation.md prints (OpenCV and numpy only, reading the
+  JSON record: the ``develop_from_record`` fixture), for every preset and ISP option.
 * DN below the black level stay in the raw mosaic unless the sensor declares black clipping;
   the dark signal is then unbiased (the bias the clipping caused is measured here too).
 * The DNG colour data follow the chain's colour model.
