@@ -70,7 +70,7 @@ def raw_image(mosaic: np.ndarray, record: Mapping[str, Any], path: str,
               dng: DngRaw | None = None) -> RawImage:
     """A :class:`RawImage` of a mosaic read from ``path``: levels, CFA and colour from the DNG
     when read from one, else from the record; clipping and ISP from the record."""
-    src = dng
+    src = dng  # None: the levels, CFA and colour data come from the record
     return RawImage(
         mosaic=mosaic,
         cfa_pattern=src.cfa_pattern if src else str(record["cfa_pattern"]),

@@ -31,7 +31,7 @@ from scenegen.imaging.raw import as_shot_neutral, color_matrix_xyz_to_camera
 
 
 def apply_imaging(linear_rgb: np.ndarray, params, camera, scene_seed: int, view_index: int,
-                  view: str, camera_name: str = "camera") -> tuple[np.ndarray, dict[str, bytes]]:
+                  view: str, *, camera_name: str) -> tuple[np.ndarray, dict[str, bytes]]:
     """One view's delivered image and its extra files ``{relative path: bytes}``: the
     vignetting map (EXR) and, with ``params.raw``, the raw mosaic (DNG and/or 16-bit PNG)."""
     result = apply_chain(linear_rgb, params, camera, seeds.frame_seed(scene_seed, view_index))
