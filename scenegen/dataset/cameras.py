@@ -6,7 +6,7 @@ Layout::
     {"format": "scenegen-dataset", "format_version": 1, "view_order": [view, ...],
      "views": {view: {"camera": Camera.to_dict(), "cam_from_world": {"R": 3x3, "t": 3},
                       "camera_name", "rig", "rig_member", "frame_index",
-                      ["view_set"], ["lights"], ["optics"]}},
+                      ["view_set"], ["lights"], ["optics"], ["raw"]}},
      "spec": the resolved spec dict (scenegen.spec.serialize.spec_to_dict)}
 """
 from __future__ import annotations
@@ -38,6 +38,8 @@ class ViewCamera:
     view_set: str | None = None  # prefix name of the spec view set the view belongs to
     lights: Mapping[str, float] | None = None  # every spec light -> factor on its spec power
     # used for this view (0 = off); None (older datasets) = not recorded
+    raw: Mapping[str, Any] | None = None  # the raw output's record (scenegen.dataset.raw), None
+    # for a view without raw files
 
     def to_dict(self) -> dict:
         cam = self.camera.to_dict() if hasattr(self.camera, "to_dict") else dict(self.camera)
@@ -51,6 +53,8 @@ class ViewCamera:
             d["lights"] = {str(k): float(v) for k, v in self.lights.items()}
         if self.optics:
             d["optics"] = dict(self.optics)
+        if self.raw is not None:
+            d["raw"] = dict(self.raw)
         return d
 
 

@@ -13,6 +13,8 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_ids.exr                    uint32 object_id, instance_id (0 = nothing)
     truth/<view>_valid.png                  uint8 mask, 255 where the pixel centre's ray hit
     truth/<view>_vignetting.exr             the imaging chain's vignetting map (channel V)
+    raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
+    images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote
     crossview/corr/<i>/<j>.exr              dense correspondences i -> j (u, v, z, state)
     crossview/flow/<i>/<j>.flo              optical flow i -> j
@@ -36,7 +38,7 @@ NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 MAX_NAME_LEN = 128
 #: A view name may not end like another view's suffixed files (view "a_ids" would clash with
 #: view "a"'s truth/a_ids.exr).
-RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting")
+RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw")
 MATCH_KINDS = ("synthetic", "sift")
 
 CROSSVIEW = "crossview"
@@ -103,6 +105,21 @@ VIGNETTING_CHANNEL = "V"
 def vignetting_path(view: str) -> str:
     """The imaging chain's vignetting map of a view (an extra file of the view)."""
     return VIGNETTING_TEMPLATE.format(view=check_view_name(view))
+
+
+#: The raw mosaic of a view of a camera with ``imaging.raw`` (templates recorded in cameras.json).
+RAW_DNG_TEMPLATE = "raw/{view}.dng"
+RAW_PNG_TEMPLATE = "images/{view}_raw.png"
+
+
+def raw_dng_path(view: str) -> str:
+    """The raw mosaic of a view as DNG (an extra file of the view)."""
+    return RAW_DNG_TEMPLATE.format(view=check_view_name(view))
+
+
+def raw_png_path(view: str) -> str:
+    """The raw mosaic of a view as a 16-bit grey PNG (an extra file of the view)."""
+    return RAW_PNG_TEMPLATE.format(view=check_view_name(view))
 
 
 # --- the scene ---------------------------------------------------------------------------------

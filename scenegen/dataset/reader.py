@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from scenegen.dataset.cameras import camera_of
+from scenegen.dataset.codecs.dng import read_dng
 from scenegen.dataset.codecs.exr import read_exr, unpack_channels
 from scenegen.dataset.codecs.json import read_json
 from scenegen.dataset.codecs.ply import read_ply
@@ -37,6 +38,7 @@ from scenegen.dataset.layout import (
     vignetting_path,
 )
 from scenegen.dataset.manifest import STATUS_COMPLETE, load_manifest
+from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
@@ -212,6 +214,23 @@ class Dataset:
         """(H, W) float32 vignetting map of the imaging chain, or None if the camera has none."""
         rel = vignetting_path(self.check_view(view))
         return read_exr(self.path(rel))[VIGNETTING_CHANNEL] if self.has(rel) else None
+
+    def raw(self, view: str, kind: str | None = None) -> RawImage | None:
+        """The raw mosaic of a view (:class:`scenegen.dataset.raw.RawImage`: uint16 DN, CFA,
+        black and white levels, colour data, the recorded ISP stages), or None if its camera
+        wrote none. ``kind``: ``'dng'`` or ``'png'``; default the DNG when written."""
+        record = self.view_info(self.check_view(view)).get("raw")
+        if record is None:
+            return None
+        files = record["files"]
+        kind = kind or ("dng" if "dng" in files else "png")
+        if kind not in files:
+            raise DatasetError(f"view {view!r} has no raw {kind} file (written: {', '.join(files)})")
+        rel, what = files[kind], f"raw mosaic of view {view!r}"
+        if kind == "dng":
+            dng = self.read(rel, read_dng, what)
+            return raw_image(dng.mosaic, record, rel, dng)
+        return raw_image(self.read(rel, read_png, what), record, rel)
 
     # --- the scene
     @property

@@ -8,12 +8,33 @@
 * 16 -> 8 bits: ``round(x / 257)`` (257 = 65535 / 255, so it inverts ``x8 * 257`` exactly).
 * Grey: OpenCV's ``COLOR_RGB2GRAY`` (ITU-R BT.601 weights, OpenCV's fixed-point rounding) of the
   8-bit image, so detectors see what a user of cv2 would feed them.
+* Colour space of the linear values: linear sRGB, i.e. the ITU-R BT.709 primaries with the D65
+  white (what Mitsuba's RGB variants render and what the sRGB encoding above assumes);
+  ``XYZ_FROM_LINEAR_SRGB`` maps it to CIE 1931 XYZ with white (1, 1, 1) -> Y = 1.
 """
 from __future__ import annotations
 
 import numpy as np
 
 BIT_DEPTHS = (8, 16)
+#: CIE 1931 xy chromaticities of the sRGB (BT.709) primaries R, G, B and of the D65 white
+#: (IEC 61966-2-1).
+SRGB_PRIMARIES_XY = ((0.64, 0.33), (0.30, 0.60), (0.15, 0.06))
+D65_WHITE_XY = (0.3127, 0.3290)
+
+
+def rgb_to_xyz_matrix(primaries_xy, white_xy) -> np.ndarray:
+    """(3, 3) linear RGB -> XYZ of an RGB space given by its primaries' and white's xy, scaled
+    so that RGB (1, 1, 1) is the white with Y = 1 (the usual derivation, e.g. SMPTE RP 177)."""
+    def xyz(x, y):
+        return np.array([x / y, 1.0, (1.0 - x - y) / y])
+
+    P = np.stack([xyz(*p) for p in primaries_xy], axis=1)  # columns: the primaries, Y = 1
+    return P * np.linalg.solve(P, xyz(*white_xy))
+
+
+#: Linear sRGB -> CIE XYZ (D65): 0.4124 0.3576 0.1805 / 0.2126 0.7152 0.0722 / 0.0193 0.1192 0.9505.
+XYZ_FROM_LINEAR_SRGB = rgb_to_xyz_matrix(SRGB_PRIMARIES_XY, D65_WHITE_XY)
 
 
 def srgb_from_linear(x) -> np.ndarray:

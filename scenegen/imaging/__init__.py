@@ -8,6 +8,8 @@ chain order (see :mod:`scenegen.imaging.chain` and docs/image_formation.md):
 * :mod:`.bayer`      colour filter array sampling and OpenCV demosaicing
 * :mod:`.noise`      EMVA 1288 sensor: QE, shot / dark / read noise, PRNU, DSNU, full well, ADC
 * :mod:`.response`   white balance, camera response (sRGB / gamma / linear), output quantisation
+* :mod:`.isp`        the stages after the sensor as a recorded list, and :func:`.isp.develop`
+* :mod:`.raw`        raw output options and the DNG colour data (colour matrix, as-shot neutral)
 * :mod:`.presets`    named cameras with documented sources
 * :mod:`.seeds`      seed derivation (scene seed, view index, stage) and fixed-pattern seeds
 
@@ -17,7 +19,8 @@ spec layer or Mitsuba.
 from scenegen.imaging.chain import ImagingParams, ImagingResult, apply_chain
 from scenegen.imaging.exposure import ExposureParams
 from scenegen.imaging.noise import SensorParams
+from scenegen.imaging.raw import RawOutput
 from scenegen.imaging.vignetting import VignettingParams
 
-__all__ = ["ImagingParams", "ImagingResult", "apply_chain", "ExposureParams", "SensorParams",
-           "VignettingParams"]
+__all__ = ["ImagingParams", "ImagingResult", "apply_chain", "ExposureParams", "RawOutput",
+           "SensorParams", "VignettingParams"]

@@ -18,7 +18,7 @@ _CHANNEL = {"R": 0, "G": 1, "B": 2}
 #: Pattern -> the two letters of OpenCV's COLOR_Bayer??2RGB code for it.
 _OPENCV_CODE = {"RGGB": "BG", "BGGR": "RG", "GRBG": "GB", "GBRG": "GR"}
 #: Reflection padding before demosaicing, pixels (even, so the colour phase is kept).
-_PAD = 4
+DEMOSAIC_PAD_PX = 4
 
 
 def _check(pattern: str) -> str:
@@ -40,17 +40,24 @@ def mosaic(rgb: np.ndarray, pattern: str) -> np.ndarray:
     return np.take_along_axis(rgb, ch[..., None].astype(np.intp), axis=2)[..., 0]
 
 
+def opencv_conversion(pattern: str, method: str) -> str:
+    """The name of the ``cv2`` colour conversion that demosaics ``pattern`` with ``method``,
+    e.g. ``COLOR_BayerBG2RGB`` for RGGB bilinear, ``COLOR_BayerBG2RGB_EA`` for edge-aware."""
+    if method not in DEMOSAIC_METHODS:
+        raise ValueError(f"demosaic method must be one of {DEMOSAIC_METHODS}, got {method!r}")
+    suffix = "_EA" if method == "edge_aware" else ""
+    return f"COLOR_Bayer{_OPENCV_CODE[_check(pattern)]}2RGB{suffix}"
+
+
 def demosaic(raw: np.ndarray, pattern: str, method: str = "bilinear") -> np.ndarray:
     """(H, W) uint8/uint16 mosaic -> (H, W, 3) RGB of the same dtype, with OpenCV.
 
     ``bilinear``: ``cv2.COLOR_Bayer??2RGB``; ``edge_aware``: ``cv2.COLOR_Bayer??2RGB_EA``.
-    The mosaic is first padded by ``_PAD`` pixels by reflection (an even count keeps the colour
+    The mosaic is first padded by ``DEMOSAIC_PAD_PX`` pixels by reflection (an even count keeps the colour
     phase: padded row -2 copies row 2, -1 copies 1), so border pixels get interior-quality
     interpolation instead of OpenCV's one-sided border handling; the result is cropped back.
     """
-    if method not in DEMOSAIC_METHODS:
-        raise ValueError(f"demosaic method must be one of {DEMOSAIC_METHODS}, got {method!r}")
-    suffix = "_EA" if method == "edge_aware" else ""
-    code = getattr(cv2, f"COLOR_Bayer{_OPENCV_CODE[_check(pattern)]}2RGB{suffix}")
-    padded = np.pad(np.asarray(raw), _PAD, mode="reflect")
-    return np.ascontiguousarray(cv2.cvtColor(padded, code)[_PAD:-_PAD, _PAD:-_PAD])
+    code = getattr(cv2, opencv_conversion(pattern, method))
+    pad = DEMOSAIC_PAD_PX
+    padded = np.pad(np.asarray(raw), pad, mode="reflect")
+    return np.ascontiguousarray(cv2.cvtColor(padded, code)[pad:-pad, pad:-pad])

@@ -13,8 +13,13 @@ Stage order (each stage's output unit in brackets):
  6. demosaic         OpenCV (only with a Bayer mosaic)                  [DN, (H, W, 3)]
  7. normalise        (dn - black) / (white - black)                     [linear, 1 = full scale]
  8. white balance    per-channel gains, clip to [0, 1]                  [linear]
+    (colour correction: the identity in this colour model, :mod:`.raw`)
  9. response         sRGB / gamma / linear                              [encoded, [0, 1]]
 10. quantise         8 or 16 bit                                        [uint8 / uint16]
+
+Stage 5's output is the raw mosaic (``ImagingResult.raw_dn``, written with ``raw:``); stages
+6-10 are the ISP, run as the recorded stage list of :func:`isp_stages` by
+:func:`scenegen.imaging.isp.develop`, so the delivered image is a function of the raw one.
 
 Random draws: stage 5 only, seeded per frame (``seed``) and per camera (fixed patterns), see
 :mod:`.seeds`. Everything else is deterministic.
@@ -26,10 +31,10 @@ from typing import Any
 
 import numpy as np
 
-from scenegen.geometry.color import quantise
-from scenegen.imaging import bayer, response, seeds
+from scenegen.imaging import bayer, isp, seeds
 from scenegen.imaging.exposure import ExposureParams, photons_per_radiance
 from scenegen.imaging.noise import SensorParams, expose_sensor
+from scenegen.imaging.raw import RawOutput
 from scenegen.imaging.vignetting import VignettingParams, vignetting_map
 
 STAGES = ("vignetting", "exposure", "quantum_efficiency", "bayer_mosaic", "sensor", "demosaic",
@@ -49,6 +54,7 @@ class ImagingParams:
     response: str = "srgb"  # response.RESPONSES
     gamma: float = 2.2  # exponent of the 'gamma' response
     bit_depth: int = 8  # output bits per channel: 8 or 16
+    raw: RawOutput | None = None  # raw files to write (None: none; the chain is the same)
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,8 +63,9 @@ class ImagingResult:
     vignetting: np.ndarray  # (H, W) float32: relative illumination V applied (the truth map)
     electrons: np.ndarray  # (H, W, 3), or (H, W) with a Bayer mosaic, float32: collected
     # electrons after full-well clipping, before read noise
-    raw_dn: np.ndarray  # like electrons, uint16: ADC output with black level (before demosaic)
-    record: dict[str, Any]  # JSON-able: parameters, derived constants and seeds used
+    raw_dn: np.ndarray  # like electrons, uint16: ADC output with black level (before demosaic):
+    # the raw mosaic, DN below black kept down to 0 unless the sensor clips at black
+    record: dict[str, Any]  # JSON-able: parameters, derived constants, ISP stages and seeds used
 
 
 def electrons_per_radiance(params: ImagingParams) -> np.ndarray:
@@ -73,6 +80,23 @@ def neutral_white_balance(params: ImagingParams) -> tuple[float, float, float]:
     """Gains (R, G, B), G = 1, that make equal-radiance R, G, B come out equal."""
     e = electrons_per_radiance(params)
     return tuple(float(e[1] / c) for c in e)
+
+
+def white_balance_gains(params: ImagingParams) -> tuple[float, float, float]:
+    """The white-balance gains (R, G, B) the chain applies: the given ones or the neutral ones."""
+    return params.white_balance if params.white_balance is not None else neutral_white_balance(params)
+
+
+def isp_stages(params: ImagingParams) -> list[dict[str, Any]]:
+    """Stages 6-10 as the JSON-able list :func:`scenegen.imaging.isp.develop` runs (and
+    cameras.json records): raw DN -> the delivered image."""
+    s = params.sensor
+    stages = [] if params.bayer is None else [isp.demosaic_stage(params.bayer, params.demosaic)]
+    return stages + [isp.normalise_stage(s.black_level_dn, s.white_level_dn),
+                     isp.white_balance_stage(white_balance_gains(params)),
+                     isp.colour_correction_stage(),
+                     isp.response_stage(params.response, params.gamma),
+                     isp.quantise_stage(params.bit_depth)]
 
 
 def apply_chain(linear_rgb: np.ndarray, params: ImagingParams, camera, seed: int) -> ImagingResult:
@@ -95,14 +119,12 @@ def apply_chain(linear_rgb: np.ndarray, params: ImagingParams, camera, seed: int
         mu_e = bayer.mosaic(mu_e, params.bayer)
     out = expose_sensor(mu_e, exposure_time_s=params.exposure.exposure_time_s,  # 5
                         gain_db=params.exposure.gain_db, sensor=s, seed=seed)
-    dn = out.dn if params.bayer is None else bayer.demosaic(out.dn, params.bayer, params.demosaic)
-    x = response.normalise(dn, s.black_level_dn, s.white_level_dn)  # 7
-    wb = params.white_balance if params.white_balance is not None else neutral_white_balance(params)
-    x = response.white_balance(x, wb)  # 8
-    img = quantise(response.encode_response(x, params.response, params.gamma),  # 9, 10
-                            params.bit_depth)
+    stages = isp_stages(params)
+    img = isp.develop(out.dn, stages)  # 6-10
+    wb = white_balance_gains(params)
     record = {
         "stages": list(STAGES),
+        "isp": stages,
         "params": asdict(params),
         "electrons_per_radiance": [float(v) for v in e_per_L],
         "system_gain_dn_per_e": s.system_gain(params.exposure.gain_db),

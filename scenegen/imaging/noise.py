@@ -14,7 +14,10 @@ per pixel, with ``mu_e`` the mean photo-electrons (photons x quantum efficiency)
 6. Gain and offset: ``y = K (n + read + dsnu_i) + black_level_dn`` with the system gain
    ``K = system_gain_dn_per_e * 10^(gain_db / 20)`` (DN per electron).
 7. ADC: ``dn = clip(floor(y + 0.5), 0, 2^adc_bits - 1)`` (uniform quantisation, adding
-   sigma_q^2 = 1/12 DN^2).
+   sigma_q^2 = 1/12 DN^2). The black level keeps the noise around zero signal on record: DN
+   below ``black_level_dn`` stay, down to the ADC's 0. Only a sensor that declares
+   ``black_level_clip`` (as some cameras' raw output does) clips at the black level instead,
+   ``dn = clip(..., black_level_dn, 2^adc_bits - 1)``.
 
 So (EMVA eqs. 5, 8) ``mu_y = K (mu_e + mu_d) + black`` and, below saturation,
 ``sigma_y^2 = K^2 (sigma_d^2 + mu_dark) + sigma_q^2 + K (mu_y - mu_y.dark)``: the photon
@@ -46,6 +49,8 @@ class SensorParams:
     prnu_percent: float = 0.0  # std of the per-pixel gain, percent of the signal
     dsnu_e: float = 0.0  # std of the per-pixel dark offset, electrons
     black_level_dn: int = 0  # offset added before the ADC, DN
+    black_level_clip: bool = False  # the sensor clips its output at black_level_dn (False: DN
+    # below black are kept down to 0, as sensors with an offset record them)
     adc_bits: int = 12  # ADC resolution, bits (1..16)
     temporal_noise: bool = True  # False: shot, dark-current and read noise replaced by means
     fixed_pattern_seed: int = 0  # seeds PRNU / DSNU (the spec derives it from the camera name)
@@ -102,5 +107,6 @@ def expose_sensor(mu_e: np.ndarray, *, exposure_time_s: float, gain_db: float,
         read = 0.0
     n = np.minimum(n, sensor.saturation_capacity_e)
     y = sensor.system_gain(gain_db) * (n + read + dsnu) + sensor.black_level_dn
-    dn = np.clip(np.floor(y + 0.5), 0, sensor.white_level_dn).astype(np.uint16)
+    floor_dn = sensor.black_level_dn if sensor.black_level_clip else 0
+    dn = np.clip(np.floor(y + 0.5), floor_dn, sensor.white_level_dn).astype(np.uint16)
     return SensorOutput(electrons=n.astype(np.float32), dn=dn)

@@ -13,7 +13,7 @@ from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.layout import target_path
 from scenegen.dataset.targets import target_document
 from scenegen.dataset.writer import DatasetWriter, software_versions
-from scenegen.imaging.stage import imaging_record
+from scenegen.imaging.stage import imaging_record, raw_view_record
 from scenegen.pipeline.crossview import run_crossview
 from scenegen.pipeline.distributed import render_views_dask
 from scenegen.pipeline.progress import FrameProgress
@@ -99,7 +99,8 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
                                        frame_index=v.frame_index, optics=view_optics(built, v),
                                        view_set=spec.view_sets[v.view_set].prefix,
-                                       lights=light_scales_dict(spec, v.light_scales))
+                                       lights=light_scales_dict(spec, v.light_scales),
+                                       raw=raw_view_record(spec.cameras[v.camera].imaging, v.name))
                  for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)

@@ -46,8 +46,10 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     params = spec.cameras[v.camera].imaging
     if params is None:  # clean path: sRGB encoding of the linear render
         image, extra = srgb_image(linear, spec.render.bit_depth), None
-    else:  # the camera's photometric chain; its vignetting map is saved as truth
-        image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name)
+    else:  # the camera's photometric chain; its vignetting map is saved as truth, its raw
+        # mosaic with imaging.raw
+        image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name,
+                                     camera_name=v.camera)
     return image, linear, _truth_for_storage(truth), extra
 
 

@@ -11,6 +11,7 @@ import dataclasses
 from dataclasses import MISSING
 
 from scenegen.geometry import optics
+from scenegen.imaging import RawOutput
 from scenegen.spec import model as m
 from scenegen.spec.model.meta import FieldInfo, spec_fields
 
@@ -45,6 +46,7 @@ RECORDS = (
     (optics.ThinLens, "cameras.NAME.lens", {}),
     (optics.Shutter, "cameras.NAME.shutter", {}),
     (optics.ChromaticAberration, "cameras.NAME.chromatic_aberration", {}),
+    (RawOutput, "cameras.NAME.imaging.raw", {}),
     (optics.Motion, "views[i].motion, objects[i].motion", {}),
     (m.Rig, "rigs.NAME", {}),
     (m.RigMember, "rigs.NAME.members[i]", {}),
@@ -133,7 +135,7 @@ def all_spec_classes() -> set[type]:
     values."""
     found = {obj for obj in vars(m).values() if isinstance(obj, type)
              and dataclasses.is_dataclass(obj)}
-    found |= {optics.ThinLens, optics.Shutter, optics.ChromaticAberration, optics.Motion}
+    found |= {optics.ThinLens, optics.Shutter, optics.ChromaticAberration, optics.Motion, RawOutput}
     return {cls for cls in found if any(not fi.meta.part for fi in spec_fields(cls))}
 
 

@@ -17,6 +17,7 @@ from types import MappingProxyType
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec import model as m
+from scenegen.spec.model.meta import spec_meta
 from scenegen.spec.views import resolve_views
 
 #: Version of the layout returned by spec_to_dict.
@@ -40,8 +41,16 @@ def _file_sha256(path: str, mtime_ns: int, size: int) -> str:
     return h.hexdigest()
 
 
+def _at_omitted_default(x, f: dataclasses.Field, v) -> bool:
+    """A field whose metadata says ``omit_default`` and whose value is its default."""
+    meta = spec_meta(type(x), f)
+    return meta is not None and meta.omit_default and f.default is not dataclasses.MISSING \
+        and v == f.default
+
+
 def _plain(x):
-    """Dataclasses, mappings, tuples, Rigid3 and paths -> JSON-able values."""
+    """Dataclasses, mappings, tuples, Rigid3 and paths -> JSON-able values (fields marked
+    ``omit_default`` left out at their default, so older specs keep their form and hash)."""
     if isinstance(x, Rigid3):
         return x.to_dict()
     if dataclasses.is_dataclass(x):
@@ -50,6 +59,8 @@ def _plain(x):
             if f.name in ("where", "path_as_written"):
                 continue
             v = getattr(x, f.name)
+            if _at_omitted_default(x, f, v):
+                continue
             if f.name == "path":
                 v = None if v is None else {"path": getattr(x, "path_as_written"),
                                            "sha256": file_sha256(v)}

@@ -12,7 +12,9 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.pfm`: Middlebury/ETH3D float maps.
 * :mod:`.kitti`: KITTI uint16 disparity PNGs.
 * :mod:`.flo`: Middlebury optical flow.
+* :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
+from scenegen.dataset.codecs.dng import DngRaw, decode_dng, encode_dng, read_dng, write_dng
 from scenegen.dataset.codecs.exr import decode_exr, encode_exr, pack_channels, read_exr, unpack_channels, write_exr
 from scenegen.dataset.codecs.flo import decode_flo, encode_flo
 from scenegen.dataset.codecs.json import decode_json, encode_json, read_json, write_json
@@ -27,6 +29,7 @@ from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
 
 __all__ = [
+    "DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng",
     "decode_exr", "encode_exr", "pack_channels", "read_exr", "unpack_channels", "write_exr",
     "decode_flo", "encode_flo", "decode_json", "encode_json", "read_json", "write_json",
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",

@@ -11,6 +11,7 @@ from scenegen.errors import Where
 from scenegen.geometry import optics
 from scenegen.geometry.camera import MODEL_NAMES, Camera
 from scenegen.geometry.pose import Rigid3
+from scenegen.imaging import ImagingParams, RawOutput, SensorParams
 from scenegen.spec.model.meta import describe_foreign, meta, param, part, where_field
 
 RIG_TYPES = ("stereo", "multi")
@@ -104,3 +105,11 @@ describe_foreign(optics.ChromaticAberration,
 describe_foreign(optics.Motion,
                  linear_velocity_mps=meta("metres / second"),
                  angular_velocity_deg_s=meta("degrees / second"))
+# The imaging chain's parameters are scenegen.imaging's (docs/image_formation.md); the fields added
+# after datasets existed are left out of the resolved spec at their default (omit_default), so
+# that a spec without them keeps its canonical form and hash.
+describe_foreign(RawOutput, dng=meta("flag: write raw/<view>.dng"),
+                 png=meta("flag: write images/<view>_raw.png (16-bit grey)"))
+describe_foreign(ImagingParams, raw=meta("scenegen.imaging.RawOutput: the raw mosaic files; "
+                                         "None = none", part=True, omit_default=True))
+describe_foreign(SensorParams, black_level_clip=meta("flag", omit_default=True))

@@ -55,6 +55,8 @@ class Meta:
     part: bool = False  # a nested record or section, not one YAML value (see part())
     doc_default: str | None = None  # how the docs state the default where one value does not
     # say it (e.g. 'required for a stereo rig')
+    omit_default: bool = False  # left out of the resolved spec (spec_to_dict) while at its
+    # default: a field added after datasets existed, so that theirs keep their bytes and hash
 
     @property
     def shown(self) -> str:
@@ -135,13 +137,19 @@ class FieldInfo:
         return self.default is MISSING and self.meta.derived is None
 
 
+def spec_meta(cls: type, f: dataclasses.Field) -> Meta | None:
+    """The spec metadata of field ``f`` of ``cls`` (its own, or described with
+    :func:`describe_foreign`), None if it has none."""
+    return f.metadata.get(META_KEY) or _FOREIGN.get(cls, {}).get(f.name)
+
+
 def field_info(cls: type, name: str) -> FieldInfo:
     """Default and metadata of field ``name`` of ``cls`` (a spec dataclass, or a foreign one
     described with :func:`describe_foreign`)."""
     f = {f.name: f for f in dataclasses.fields(cls)}.get(name)
     if f is None:
         raise AttributeError(f"{cls.__name__} has no field {name!r}")
-    meta_ = f.metadata.get(META_KEY) or _FOREIGN.get(cls, {}).get(name)
+    meta_ = spec_meta(cls, f)
     if meta_ is None:
         raise TypeError(f"{cls.__name__}.{name} has no spec metadata (declare it with param())")
     if meta_.derived is not None:

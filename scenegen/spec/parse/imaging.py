@@ -5,14 +5,16 @@ from __future__ import annotations
 import dataclasses
 
 from scenegen.geometry.color import BIT_DEPTHS
-from scenegen.imaging import ImagingParams, bayer, presets, response
+from scenegen.imaging import ImagingParams, RawOutput, bayer, presets, response
 from scenegen.imaging import seeds as imaging_seeds
 from scenegen.located_yaml import Node
 from scenegen.spec.model.meta import SEED_MAX
 from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.read import read_bool
 
 KEYS = ("preset", "exposure", "vignetting", "sensor", "bayer", "demosaic", "white_balance",
-        "response", "gamma", "bit_depth")
+        "response", "gamma", "bit_depth", "raw")
+RAW_KEYS = tuple(f.name for f in dataclasses.fields(RawOutput))
 _POS = dict(lo=0.0, lo_open=True)
 #: key -> reader(node) of each sub-block of parameters; absent keys keep the preset's value.
 BLOCKS = {
@@ -36,6 +38,7 @@ BLOCKS = {
         "prnu_percent": lambda n: n.as_float("percent", lo=0.0, hi=100.0),
         "dsnu_e": lambda n: n.as_float("electrons", lo=0.0),
         "black_level_dn": lambda n: n.as_int("DN", lo=0),
+        "black_level_clip": lambda n: n.as_bool(),
         "adc_bits": lambda n: n.as_int("bits", lo=1, hi=16),
         "temporal_noise": lambda n: n.as_bool(),
         "fixed_pattern_seed": lambda n: n.as_int(lo=0, hi=SEED_MAX)},
@@ -81,9 +84,16 @@ def parse_imaging(node: Node, camera_name: str, ctx: ParseContext) -> ImagingPar
         else:
             wn.as_enum(("auto",), "white balance: 3 gains or auto")
             wb = None  # auto: equal-radiance white comes out neutral
+    raw = p.raw
+    if "raw" in f:
+        raw = parse_raw(f.get("raw"))
+        if raw is not None and pattern is None:
+            where = f.get("bayer") if "bayer" in f else f.get("raw")
+            raise where.error("raw output is the colour filter mosaic; with bayer: none there is "
+                              "none (give a Bayer pattern, or remove raw)")
     return dataclasses.replace(
         p, exposure=parts["exposure"], vignetting=parts["vignetting"], sensor=sensor,
-        bayer=pattern, white_balance=wb,
+        bayer=pattern, white_balance=wb, raw=raw,
         demosaic=f.get("demosaic").as_enum(bayer.DEMOSAIC_METHODS, "demosaic method")
         if "demosaic" in f else p.demosaic,
         response=f.get("response").as_enum(response.RESPONSES, "camera response")
@@ -91,3 +101,20 @@ def parse_imaging(node: Node, camera_name: str, ctx: ParseContext) -> ImagingPar
         gamma=f.float("gamma", p.gamma, "exponent", lo=0.0, lo_open=True),
         bit_depth=f.get("bit_depth").as_enum(BIT_DEPTHS, "bit depth") if "bit_depth" in f
         else ctx.render.bit_depth)
+
+
+def parse_raw(node: Node) -> RawOutput | None:
+    """``raw: true`` (the defaults), ``raw: false`` (none) or ``raw: {dng: bool, png: bool}``."""
+    if not node.is_mapping:
+        v = node.scalar() if not node.is_sequence else None
+        if not isinstance(v, bool):
+            raise node.error("expected true, false or a mapping {dng: true/false, png: "
+                             f"true/false}}, got {node.describe()}")
+        return RawOutput() if v else None
+    f = node.as_mapping("raw outputs: {dng: true/false, png: true/false}, or true / false")
+    f.check(optional=RAW_KEYS)
+    out = RawOutput(**{k: read_bool(f, RawOutput, k) for k in RAW_KEYS})
+    if not any(getattr(out, k) for k in RAW_KEYS):
+        raise node.error(f"raw: every output ({', '.join(RAW_KEYS)}) is off; write raw: false "
+                         "(or remove it) for no raw files")
+    return out

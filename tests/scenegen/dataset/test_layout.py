@@ -10,7 +10,7 @@ def test_bad_names_are_refused(name):
         layout.check_name("object", name)
 
 
-@pytest.mark.parametrize("view", ["a_ids", "a_linear", "a_valid", "a_vignetting"])
+@pytest.mark.parametrize("view", ["a_ids", "a_linear", "a_valid", "a_vignetting", "a_raw"])
 def test_view_names_may_not_collide_with_suffixed_files(view):
     with pytest.raises(ValueError, match="collide"):
         layout.view_paths(view)
@@ -27,6 +27,8 @@ def test_documented_paths():
         "image": "images/cam_0001.png", "linear": "images/cam_0001_linear.exr", "truth": "truth/cam_0001.exr",
         "ids": "truth/cam_0001_ids.exr", "valid": "truth/cam_0001_valid.png"}
     assert layout.vignetting_path("v") == "truth/v_vignetting.exr"
+    assert layout.raw_dng_path("v") == "raw/v.dng"
+    assert layout.raw_png_path("v") == "images/v_raw.png"
     assert layout.mesh_path("ball") == "scene/meshes/ball.ply"
     assert layout.target_path("board") == "scene/targets/board.json"
     assert layout.correspondence_path("a", "b") == "crossview/corr/a/b.exr"

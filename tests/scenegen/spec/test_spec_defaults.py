@@ -15,6 +15,7 @@ from scenegen.errors import SpecError
 from scenegen.geometry import optics
 from scenegen.geometry.camera import MODEL_NAMES, MODELS
 from scenegen.geometry.color import BIT_DEPTHS
+from scenegen.imaging import RawOutput
 from scenegen.located_yaml import Document
 from scenegen.spec import model as m
 from scenegen.spec import parse_spec, reference
@@ -101,6 +102,9 @@ CASES = [
        lambda s, k=k: getattr(s.view_sets[0].motion, k), v)
       for k, v in (("linear_velocity_mps", (1.0, 0.0, 0.0)),
                    ("angular_velocity_deg_s", (0.0, 0.0, 10.0)))],
+    *[(RawOutput, k, CAM.replace("fx: 50", f"fx: 50, imaging: {{bayer: RGGB, raw: {{{given}: true}}}}"),
+       lambda s, k=k: getattr(s.cameras["cam"].imaging.raw, k), v)
+      for k, given, v in (("dng", "png", False), ("png", "dng", True))],
     (m.Rig, "vergence_deg", CAM + "rigs:\n  st: {type: stereo, left: cam, right: cam, "
      "baseline_m: 0.1}\n", lambda s: s.rigs["st"].vergence_deg, 4.0),
     *[(m.Orbit, k, CAM + "views:\n  - camera: cam\n    orbit: {radius_m: 2, count: 2}\n",

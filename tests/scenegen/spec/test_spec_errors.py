@@ -235,6 +235,34 @@ CASES = [
      "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: smartphone\n"
      "      sensor:\n        black_level_dn: 1023\n",
      8, "cameras.cam.imaging.sensor.black_level_dn", "expected black_level_dn < 2^adc_bits - 1"),
+    # imaging.raw (issue 19): opt-in raw mosaic files
+    ("imaging_raw_without_bayer",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: dslr\n"
+     "      bayer: none\n      raw: true\n",
+     7, "cameras.cam.imaging.bayer", "raw output is the colour filter mosaic; with bayer: none"),
+    ("imaging_raw_default_camera_has_no_bayer",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {raw: true}\n",
+     5, "cameras.cam.imaging.raw", "give a Bayer pattern, or remove raw"),
+    ("imaging_raw_every_output_off",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: dslr\n"
+     "      raw: {dng: false}\n",
+     7, "cameras.cam.imaging.raw", "every output (dng, png) is off"),
+    ("imaging_raw_unknown_key",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: dslr\n"
+     "      raw: {tiff: true}\n",
+     7, "cameras.cam.imaging.raw.tiff", "unknown key 'tiff'"),
+    ("imaging_raw_not_a_flag",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: dslr\n"
+     "      raw: dng\n",
+     7, "cameras.cam.imaging.raw", "expected true, false or a mapping {dng: true/false, png: true/false}"),
+    ("imaging_raw_flag_not_bool",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      preset: dslr\n"
+     "      raw: {png: 1}\n",
+     7, "cameras.cam.imaging.raw.png", "expected true or false"),
+    ("imaging_black_level_clip_not_bool",
+     "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging:\n      sensor:\n"
+     "        black_level_clip: yes please\n",
+     7, "cameras.cam.imaging.sensor.black_level_clip", "expected true or false"),
     ("imaging_bad_white_balance",
      "cameras:\n  cam:\n    size: [64, 48]\n    fx: 50\n    imaging: {white_balance: daylight}\n",
      5, "cameras.cam.imaging.white_balance", "expected one of 'auto'"),
