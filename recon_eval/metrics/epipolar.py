@@ -24,19 +24,27 @@ from scenegen.geometry.twoview import apply_homography, homogeneous, sampson_err
 RANK2_REL_TOL = 1e-6
 
 
+#: s3 / s1 of H below this is "singular": it maps the image onto a line or a point.
+SINGULAR_REL_TOL = 1e-12
+
+
+def _singular_value_ratio(M) -> tuple[float | None, str | None]:
+    """(s3 / s1 of a finite, non-zero 3x3 matrix, None) or (None, why it has none)."""
+    M = np.asarray(M, dtype=np.float64)
+    if M.shape != (3, 3):
+        return None, f"shape {M.shape}, expected (3, 3)"
+    if not np.all(np.isfinite(M)):
+        return None, "non-finite"
+    s = np.linalg.svd(M, compute_uv=False)
+    if s[0] == 0:
+        return None, "zero"
+    return float(s[2] / s[0]), None
+
+
 def fundamental_degeneracy(F) -> str | None:
     """Why an estimated F cannot be scored, or None. Reasons: 'non-finite', 'zero', 'rank 3'."""
-    F = np.asarray(F, dtype=np.float64)
-    if F.shape != (3, 3):
-        return f"shape {F.shape}, expected (3, 3)"
-    if not np.all(np.isfinite(F)):
-        return "non-finite"
-    s = np.linalg.svd(F, compute_uv=False)
-    if s[0] == 0:
-        return "zero"
-    if s[2] / s[0] > RANK2_REL_TOL:
-        return "rank 3"
-    return None
+    ratio, why = _singular_value_ratio(F)
+    return why if why is not None else ("rank 3" if ratio > RANK2_REL_TOL else None)
 
 
 def sampson_sq_px2(F, x1, x2) -> np.ndarray:
@@ -216,17 +224,9 @@ def inlier_precision_recall(est_inliers, true_inliers) -> InlierResult:
 
 # --- homographies ------------------------------------------------------------------------------
 def homography_degeneracy(H) -> str | None:
-    H = np.asarray(H, dtype=np.float64)
-    if H.shape != (3, 3):
-        return f"shape {H.shape}, expected (3, 3)"
-    if not np.all(np.isfinite(H)):
-        return "non-finite"
-    s = np.linalg.svd(H, compute_uv=False)
-    if s[0] == 0:
-        return "zero"
-    if s[2] / s[0] < 1e-12:  # numerically singular: maps the image onto a line or point
-        return "singular"
-    return None
+    """Why an estimated H cannot be scored, or None. Reasons: 'non-finite', 'zero', 'singular'."""
+    ratio, why = _singular_value_ratio(H)
+    return why if why is not None else ("singular" if ratio < SINGULAR_REL_TOL else None)
 
 
 @dataclass(frozen=True)
