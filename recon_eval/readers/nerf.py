@@ -73,7 +73,7 @@ def _camera(fields: dict, where: str):
         name = str(fields.get("camera_model", "OPENCV")).upper()
         if name not in NERF_CAMERA_MODELS:
             raise InputError(f"{where}: camera_model {name!r} is not supported (OPENCV, OPENCV_FISHEYE, PINHOLE)")
-        if camera_model(COLMAP_MODELS[name]).wide_angle:  # OPENCV_FISHEYE: Kannala-Brandt k1..k4
+        if camera_model(COLMAP_MODELS[name]).opencv_fisheye:  # OPENCV_FISHEYE: Kannala-Brandt k1..k4
             return Camera(COLMAP_MODELS[name], w, h, fx, fy, cx, cy, 0.0, (k["k1"], k["k2"], k["k3"], k["k4"]))
         dist = (k["k1"], k["k2"], k["p1"], k["p2"], k["k3"])
         return Camera("opencv" if any(dist) else "pinhole", w, h, fx, fy, cx, cy, 0.0, dist if any(dist) else ())
@@ -136,7 +136,7 @@ def write_nerf_transforms(path, poses: Poses, camera=None, *, extension: str = "
         cx, cy = colmap_from_opencv_pixels([camera.cx, camera.cy])
         doc.update(w=camera.width, h=camera.height, fl_x=camera.fx, fl_y=camera.fy, cx=float(cx), cy=float(cy))
         c = camera.coefficients()
-        if camera_model(camera.model).wide_angle:
+        if camera_model(camera.model).opencv_fisheye:
             doc.update(camera_model="OPENCV_FISHEYE", **c)
         else:
             doc.update(camera_model="OPENCV", **{k: c.get(k, 0.0) for k in ("k1", "k2", "p1", "p2", "k3")})

@@ -114,7 +114,7 @@ def read_opencv_calibration(path, *, model: str | None = None, size: tuple | Non
     if not (float(W).is_integer() and float(H).is_integer() and W > 0 and H > 0):
         raise InputError(f"{p}: image_width/image_height: expected positive integers, got {W}, {H}")
     try:
-        if model == "fisheye":
+        if camera_model(model).opencv_fisheye:
             if D.size != 4:
                 raise InputError(f"{p}: {dname or 'distortion_coefficients'}: a fisheye needs 4 coefficients k1..k4, got {D.size}")
             return Camera.from_opencv_fisheye(K, D, (int(W), int(H)))
@@ -132,5 +132,5 @@ def write_opencv_calibration(path, camera) -> None:
     fs.write("image_height", int(camera.height))
     fs.write("camera_matrix", np.asarray(K, np.float64))
     fs.write("distortion_coefficients", np.asarray(D, np.float64).reshape(1, -1))
-    fs.write("distortion_model", "equidistant" if camera_model(camera.model).wide_angle else "plumb_bob")
+    fs.write("distortion_model", "equidistant" if camera_model(camera.model).opencv_fisheye else "plumb_bob")
     fs.release()

@@ -103,7 +103,7 @@ def _write_yaml(path, width, height, K, D, model, rms, per_view, views, flags, b
     fs.write("image_height", int(height))
     fs.write("camera_matrix", np.asarray(K, np.float64))
     fs.write("distortion_coefficients", np.asarray(D, np.float64).reshape(1, -1))
-    fs.write("distortion_model", "equidistant" if model == "fisheye" else "plumb_bob")
+    fs.write("distortion_model", "equidistant" if camera_model(model).opencv_fisheye else "plumb_bob")
     fs.write("avg_reprojection_error", float(rms))
     fs.write("per_view_reprojection_errors", np.asarray(per_view, np.float64).reshape(-1, 1))
     fs.write("nr_of_frames", len(views))
@@ -149,7 +149,7 @@ def calibrate(ds, out_dir, *, board_kind: str, fisheye: bool,
     for cam_name, views in groups.items():
         pre = "" if len(groups) == 1 else f"{cam_name}."  # metric names carry the camera when several
         cam0, _ = ds.camera(views[0])
-        if fisheye != camera_model(cam0.model).wide_angle:
+        if fisheye != camera_model(cam0.model).opencv_fisheye:
             continue
         detect = _checkerboard_detections if board_kind == "checkerboard" else _charuco_detections
         used, objs, imgs = detect(ds, views, geo, truth)

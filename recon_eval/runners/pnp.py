@@ -61,7 +61,7 @@ def run(ds, out_dir, options) -> RunOutput:
     out = RunOutput()
     for v in ds.views:
         cam, pose = ds.camera(v)
-        if camera_model(cam.model).wide_angle:  # solvePnP takes OpenCV's perspective models only
+        if camera_model(cam.model).opencv_fisheye:  # solvePnP takes OpenCV's perspective models only
             continue
         K, D = cam.to_opencv()
         inputs = {}
