@@ -3,6 +3,7 @@
 ::
 
     recon-eval features RESULT DATASET [--eps PX] [--pixel-origin center|corner] [--pairs all|I:J ...]
+                       [--repeatability all_keypoints|superpoint]
 
 RESULT holds ``keypoints/<view>.txt|.npy`` and ``matches/<view_i>__<view_j>.txt|.npy``
 (:mod:`recon_eval.readers.features`); DATASET is a scenegen dataset with cross-view truth. Scores
@@ -13,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from recon_eval.cli.scored import scored
+from recon_eval.metrics.features import REPEATABILITY_DEFINITIONS
 from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report import plots
@@ -31,14 +33,18 @@ def arguments(p) -> None:
                         "corner (COLMAP, VLFeat: 0.5 is subtracted on reading)")
     p.add_argument("--pairs", nargs="+", default=["all"], metavar="all|I:J",
                    help="pairs to score: all crossview pairs (default) or VIEW_I:VIEW_J ...")
+    p.add_argument("--repeatability", choices=REPEATABILITY_DEFINITIONS, default=REPEATABILITY_DEFINITIONS[0],
+                   help="all_keypoints (default): the nearest among all keypoints of the other view; superpoint: "
+                        "SuperPoint's reference, both sets restricted to the shared region (docs/features.md)")
 
 
 def score(a):
     ds = read_dataset(a.dataset)
     pairs = select_pairs(ds, a.pairs)
     files = read_feature_files(a.result, [], pairs, a.pixel_origin)
-    ev = evaluate_features(ds, files.keypoints, files.matches, pairs, a.eps)
+    ev = evaluate_features(ds, files.keypoints, files.matches, pairs, a.eps, a.repeatability)
     inputs = {"result": a.result, "dataset": a.dataset, "eps_px": a.eps, "pixel_origin": a.pixel_origin,
+              "repeatability_definition": a.repeatability,
               "pairs": [f"{i}:{j}" for i, j in pairs],
               "files": {k: None if f is None else str(f) for k, f in files.files.items()}}
     return inputs, results_dict(ev, files), lambda: feature_figures(ev)

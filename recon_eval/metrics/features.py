@@ -9,11 +9,27 @@ pixel centre needs only that centre; one near an occlusion boundary or outside
 [0, W - 1] x [0, H - 1] has none). This is the "region visible in both views", occlusion aware.
 
 * Repeatability and localisation error (SuperPoint, DeTone et al. 2018, sec. 7.2 and their
-  evaluation code): keypoints of i with truth are mapped into j, keypoints of j with truth (through
-  the j -> i map) into i; a mapped keypoint is *repeated* when the nearest keypoint of the other
-  view lies within ``eps_px`` (``<=``). repeatability = (repeated_i + repeated_j) / (n_i + n_j)
-  over keypoints with truth; localisation error = mean distance to that nearest keypoint over the
-  repeated ones. The nearest keypoint is searched among all keypoints of the other view.
+  evaluation code), two definitions (:data:`REPEATABILITY_DEFINITIONS`):
+
+  - ``all_keypoints`` (the default): keypoints of i with truth are mapped into j, keypoints of j
+    with truth (through the j -> i map) into i; a mapped keypoint is *repeated* when the nearest
+    keypoint of the other view lies within ``eps_px`` (``<=``), the nearest being searched among
+    ALL keypoints of the other view (one without truth included, e.g. on an occlusion edge).
+    repeatability = (repeated_i + repeated_j) / (n_i + n_j) over keypoints with truth;
+    localisation error = mean distance to that nearest keypoint over the repeated ones.
+  - ``superpoint``: the reference's (``compute_repeatability`` of rpautrat/SuperPoint,
+    ``superpoint/evaluations/detector_evaluation.py``): both sets are first restricted to the
+    shared region (keypoints with truth in the other view), and every distance is measured in
+    view j, between the keypoints of i mapped into j and the restricted keypoints of j:
+    count_i = mapped keypoints of i whose nearest restricted keypoint of j is within eps,
+    count_j = restricted keypoints of j whose nearest mapped keypoint of i is within eps;
+    repeatability = (count_i + count_j) / (n_i + n_j) (the reference's top-k selection by score is
+    the caller's: pass the keypoints to score). Localisation error: the mean of those nearest
+    distances within eps, both counts, in j.
+
+  The two differ where the views' scales differ (the reference measures j's keypoints in j, the
+  default in i) and for keypoints of the other view without truth (on an occlusion edge or just
+  outside the shared region), which only the default can find as a nearest neighbour.
 * Mean matching accuracy MMA@t (D2-Net, Dusmanu et al. 2019, HPatches protocol): for putative
   matches (x_i, x_j), the distance between the truth position of x_i in j and x_j; MMA@t = fraction
   of matches with distance ``<= t`` px, for t = 1..10, per image pair, then averaged over pairs
@@ -45,6 +61,8 @@ from recon_eval.arrays import as_float_array, frozen
 from recon_eval.errors import InputError
 from scenegen.dataset.crossview import VISIBLE  # the dataset's one visibility truth
 
+#: Repeatability definitions (module docstring); the first is the default.
+REPEATABILITY_DEFINITIONS = ("all_keypoints", "superpoint")
 #: Thresholds of MMA, pixels (D2-Net plots 1..10).
 MMA_THRESHOLDS_PX = tuple(float(t) for t in range(1, 11))
 
@@ -109,6 +127,7 @@ class Repeatability:
     n_j: int
     repeated_i: int
     repeated_j: int
+    definition: str = REPEATABILITY_DEFINITIONS[0]  # which of REPEATABILITY_DEFINITIONS
 
 
 def _nearest(points: np.ndarray, targets: np.ndarray) -> np.ndarray:
@@ -118,21 +137,29 @@ def _nearest(points: np.ndarray, targets: np.ndarray) -> np.ndarray:
 
 
 def repeatability(kp_i, kp_j, map_ij: CorrespondenceMap, map_ji: CorrespondenceMap,
-                  eps_px: float = 3.0) -> Repeatability:
+                  eps_px: float = 3.0, definition: str = REPEATABILITY_DEFINITIONS[0]) -> Repeatability:
     """Detector repeatability and localisation error of keypoints ``kp_i`` (N, 2) of view i and
-    ``kp_j`` (M, 2) of view j (OpenCV pixels), SuperPoint definition (module docstring)."""
+    ``kp_j`` (M, 2) of view j (OpenCV pixels), by ``definition`` (``all_keypoints`` or
+    ``superpoint``, module docstring)."""
+    if definition not in REPEATABILITY_DEFINITIONS:
+        raise InputError(f"repeatability definition must be one of {REPEATABILITY_DEFINITIONS}, got {definition!r}")
     kp_i = as_float_array(kp_i, "kp_i", (None, 2))
     kp_j = as_float_array(kp_j, "kp_j", (None, 2))
     mi, oki = map_keypoints(kp_i, map_ij)
     mj, okj = map_keypoints(kp_j, map_ji)
-    di = _nearest(mi[oki], kp_j[np.all(np.isfinite(kp_j), axis=1)])
-    dj = _nearest(mj[okj], kp_i[np.all(np.isfinite(kp_i), axis=1)])
+    if definition == "superpoint":  # both sets in the shared region, every distance in j
+        a, b = mi[oki], kp_j[okj]
+        di, dj = _nearest(a, b), _nearest(b, a)
+    else:
+        di = _nearest(mi[oki], kp_j[np.all(np.isfinite(kp_j), axis=1)])
+        dj = _nearest(mj[okj], kp_i[np.all(np.isfinite(kp_i), axis=1)])
     ri, rj = di <= eps_px, dj <= eps_px
     n = int(oki.sum() + okj.sum())
     nrep = int(ri.sum() + rj.sum())
     rep = nrep / n if n else float("nan")
     loc = float((di[ri].sum() + dj[rj].sum()) / nrep) if nrep else float("nan")
-    return Repeatability(float(eps_px), rep, loc, int(oki.sum()), int(okj.sum()), int(ri.sum()), int(rj.sum()))
+    return Repeatability(float(eps_px), rep, loc, int(oki.sum()), int(okj.sum()), int(ri.sum()), int(rj.sum()),
+                         definition)
 
 
 @dataclass(frozen=True)

@@ -76,6 +76,7 @@ def _charuco_detections(ds, views, geo, truth):
     d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, geo["dictionary"]))
     board = cv2.aruco.CharucoBoard((int(geo["squares_x"]), int(geo["squares_y"])), float(geo["square_m"]),
                                    float(geo["marker_m"]), d)
+    board.setLegacyPattern(bool(geo.get("legacy_pattern", False)))  # the spec's ChArUco layout
     params = cv2.aruco.CharucoParameters()
     params.minMarkers = CHARUCO_MIN_MARKERS
     det = cv2.aruco.CharucoDetector(board, params)

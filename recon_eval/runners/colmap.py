@@ -2,6 +2,12 @@
 spec camera, COLMAP's SIMPLE_RADIAL model initialised from its default focal guess: no truth
 intrinsics), exhaustive matching, incremental mapping. CPU only.
 
+Reproducible: every stage runs on one thread and every COLMAP random generator (the global PRNG,
+geometric verification's RANSAC, the mapper, the triangulator) is seeded with :data:`SEED`, so
+two runs on the same dataset give the same model bit for bit (with threads, the order in which
+matches and bundle-adjustment residuals are accumulated varied the max rotation error by ~1e-3
+deg from run to run).
+
 Raw output: ``colmap/database.db`` and the largest model ``colmap/sparse/`` (COLMAP binary).
 Scores (recon_eval.metrics.poses): APE after Sim(3) Umeyama alignment on the camera centres (rotation
 error per camera, translation error in metres), registration ratio (an unregistered view is a
@@ -26,6 +32,20 @@ from recon_eval.runners.common import RunOutput, out_path
 TAU_M = 0.01
 #: SIFT features per image (COLMAP's default is 8192; the library scenes are small images).
 MAX_FEATURES = 4096
+#: Seed of every COLMAP random generator; threads of every stage (both fixed: reproducible runs).
+SEED = 0
+THREADS = 1
+
+
+def mapping_options(pycolmap):
+    """COLMAP's incremental pipeline options, defaults but for :data:`THREADS` and :data:`SEED`."""
+    o = pycolmap.IncrementalPipelineOptions()
+    o.num_threads = THREADS
+    o.random_seed = SEED
+    o.mapper.num_threads = THREADS
+    o.mapper.random_seed = SEED
+    o.triangulation.random_seed = SEED
+    return o
 
 
 def incremental(ds, out_dir, options) -> RunOutput:
@@ -39,14 +59,22 @@ def incremental(ds, out_dir, options) -> RunOutput:
     for v in ds.views:
         shutil.copy(ds.image_path(v), work / f"{v}.png")
     db = work.parent / "database.db"
+    pycolmap.set_random_seed(SEED)
     ext = pycolmap.FeatureExtractionOptions()
     ext.sift.max_num_features = MAX_FEATURES
+    ext.num_threads = THREADS
     pycolmap.extract_features(db, work, camera_mode=pycolmap.CameraMode.SINGLE, extraction_options=ext,
                               device=pycolmap.Device.cpu)
-    pycolmap.match_exhaustive(db, device=pycolmap.Device.cpu)
+    match = pycolmap.FeatureMatchingOptions()
+    match.num_threads = THREADS
+    verify = pycolmap.TwoViewGeometryOptions()
+    verify.ransac.random_seed = SEED
+    verify.ransac.num_threads = THREADS
+    pycolmap.match_exhaustive(db, matching_options=match, verification_options=verify, device=pycolmap.Device.cpu)
     sparse = work.parent / "sparse_all"
-    recs = pycolmap.incremental_mapping(db, work, sparse)
+    recs = pycolmap.incremental_mapping(db, work, sparse, options=mapping_options(pycolmap))
     out = RunOutput()
+    out.notes.update({"seed": SEED, "threads": THREADS})
     if not recs:
         out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
         out.notes["failed"] = "no reconstruction"

@@ -23,6 +23,7 @@ def detect_board_points(image, geo: dict, truth: dict) -> tuple[np.ndarray, np.n
     if geo["kind"] == "charuco":
         board = cv2.aruco.CharucoBoard((int(geo["squares_x"]), int(geo["squares_y"])), float(geo["square_m"]),
                                        float(geo["marker_m"]), d)
+        board.setLegacyPattern(bool(geo.get("legacy_pattern", False)))  # the spec's ChArUco layout
         corners, ids, _, _ = cv2.aruco.CharucoDetector(board).detectBoard(g)
         if ids is None:
             return np.zeros((0, 2)), np.zeros((0, 3))

@@ -29,6 +29,7 @@ from recon_eval.metrics.features import (
     MatchAccuracy,
     MatchingScore,
     MatchPrecisionRecall,
+    REPEATABILITY_DEFINITIONS,
     Repeatability,
     check_match_indices,
     match_accuracy,
@@ -180,13 +181,15 @@ def describe_pair(ds, i: str, j: str, map_ij: CorrespondenceMap) -> PairDescript
 
 # --- scoring ---------------------------------------------------------------------------------
 def score_pair(kp_i, kp_j, matches, map_ij: CorrespondenceMap, map_ji: CorrespondenceMap,
-               description: PairDescription, eps_px: float = DEFAULT_EPS_PX) -> PairScore:
+               description: PairDescription, eps_px: float = DEFAULT_EPS_PX,
+               repeatability_definition: str = REPEATABILITY_DEFINITIONS[0]) -> PairScore:
     """Every metric of one pair: keypoints ``kp_i`` (N, 2), ``kp_j`` (K, 2) OpenCV px, putative
-    ``matches`` (M, 2) int indices (i -> j)."""
+    ``matches`` (M, 2) int indices (i -> j); repeatability by ``repeatability_definition``
+    (:data:`recon_eval.metrics.features.REPEATABILITY_DEFINITIONS`)."""
     kp_i, kp_j = np.asarray(kp_i, np.float64).reshape(-1, 2), np.asarray(kp_j, np.float64).reshape(-1, 2)
     mt = check_match_indices(matches, len(kp_i), len(kp_j))
     return PairScore(description, len(kp_i), len(kp_j),
-                     repeatability(kp_i, kp_j, map_ij, map_ji, eps_px),
+                     repeatability(kp_i, kp_j, map_ij, map_ji, eps_px, repeatability_definition),
                      match_accuracy(kp_i[mt[:, 0]], kp_j[mt[:, 1]], map_ij),
                      matching_score(kp_i, kp_j, mt, map_ij, map_ji, eps_px),
                      match_precision_recall(kp_i, kp_j, mt, map_ij, eps_px))
@@ -230,7 +233,8 @@ def summarise(scores, series: str, kind: str | None = None) -> SeriesSummary:
                          float(loc_sum / n_rep) if n_rep else float("nan"), ms, prec, rec, int(np.sum(b1 | b2 | b3)))
 
 
-def evaluate_features(ds, keypoints: dict, matches: dict, pairs, eps_px: float = DEFAULT_EPS_PX) -> FeatureEvaluation:
+def evaluate_features(ds, keypoints: dict, matches: dict, pairs, eps_px: float = DEFAULT_EPS_PX,
+                      repeatability_definition: str = REPEATABILITY_DEFINITIONS[0]) -> FeatureEvaluation:
     """Score ``keypoints`` (view -> (N, 2) OpenCV px; a missing view has none) and ``matches``
     ((i, j) -> (M, 2) int indices; a missing pair has none) on ``pairs`` of dataset ``ds``."""
     if not eps_px > 0:
@@ -241,7 +245,8 @@ def evaluate_features(ds, keypoints: dict, matches: dict, pairs, eps_px: float =
         desc = describe_pair(ds, i, j, map_ij)
         none = np.zeros((0, 2))
         scores.append(score_pair(keypoints.get(i, none), keypoints.get(j, none),
-                                 matches.get((i, j), np.zeros((0, 2), np.int64)), map_ij, map_ji, desc, eps_px))
+                                 matches.get((i, j), np.zeros((0, 2), np.int64)), map_ij, map_ji, desc, eps_px,
+                                 repeatability_definition))
     by_series: dict = {}
     for s in scores:
         by_series.setdefault(s.description.series, []).append(s)

@@ -7,7 +7,8 @@ it sees ``(spec, variant, spp, Mitsuba variant)`` and keeps it (:data:`_SCENES`,
 :func:`scenegen.dataset.writer.write_view_files` and returns the hashes. The client records each
 view with :meth:`~scenegen.dataset.writer.DatasetWriter.record_views` in the run's order (every frame
 already done at once: one manifest rewrite, whose cost grows with the run), so the manifest is
-byte-identical to a serial run's, and a run killed at any point resumes like a serial one.
+byte-identical to a serial run's, and a run killed at any point resumes like a serial one. A
+worker killed mid-write leaves a temporary file; the client removes those once every task is done.
 
 Workers must see the output folder at the same path (one machine, or a shared file system).
 Mitsuba is imported in a worker only through :func:`scenegen.render.load_scene`, which points
@@ -21,6 +22,7 @@ import os
 from collections import OrderedDict
 from pathlib import Path
 
+from scenegen.dataset.files import remove_stale_temp_files
 from scenegen.dataset.writer import write_view_files
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import configure_llvm, load_scene
@@ -133,4 +135,7 @@ def render_views_dask(client, source, writer, pending, *, spp: int, seed: int, v
     finally:
         for fut in futures:
             fut.cancel()
+    # A worker killed mid-write leaves its temporary file (the task reran elsewhere): every task
+    # is done now, so nothing writes under out_dir but this process
+    remove_stale_temp_files(out_dir)
     return n

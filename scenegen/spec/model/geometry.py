@@ -116,6 +116,8 @@ class CharucoTarget:
     dictionary: str = param(unit="ArUco dictionary", choices=tuple(ARUCO_DICTIONARIES))
     # cv2.aruco predefined dictionary name, e.g. 'DICT_5X5_100'
     margin_m: float = param(unit="metres", lo=0.0, derived=_MARGIN)  # white border
+    legacy_pattern: bool = param(False, unit="flag", omit_default=True)  # OpenCV's layout before
+    # 4.6 (setLegacyPattern): with an even squares_y the top-left square is white
     kind: str = field(default="charuco", init=False)
 
 

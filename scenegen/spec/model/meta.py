@@ -80,11 +80,11 @@ def _number(x) -> str:
 def param(default: Any = MISSING, *, unit: str, label: str | None = None, lo=None, hi=None,
           lo_open: bool = False, hi_open: bool = False, choices=None, derived: str | None = None,
           yaml_default: Any = NOT_GIVEN, doc_default: str | None = None,
-          default_factory: Any = MISSING):
+          default_factory: Any = MISSING, omit_default: bool = False):
     """A dataclass field for one spec value: its default and :class:`Meta`."""
     meta = Meta(unit=unit, label=label, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open,
                 choices=tuple(choices) if choices is not None else None, derived=derived,
-                yaml_default=yaml_default, doc_default=doc_default)
+                yaml_default=yaml_default, doc_default=doc_default, omit_default=omit_default)
     return field(default=default, default_factory=default_factory, metadata={META_KEY: meta})
 
 

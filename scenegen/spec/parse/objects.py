@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from typing import Mapping
 
+from scenegen.assets.board_raster import BoardRasterError, layout_of, texels_per_unit
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
-from scenegen.spec.parse.read import read_enum, read_float, read_floats, read_int, seed_or_none
+from scenegen.spec.parse.read import read_bool, read_enum, read_float, read_floats, read_int, seed_or_none
 from scenegen.spec.parse.transforms import parse_transform
 
 #: The keys of each shape type, besides `type`.
@@ -94,7 +95,18 @@ def parse_shape(node: Node, ctx: ParseContext) -> mg.Shape:
 
 
 def parse_target(node: Node) -> mg.Target:
+    """A calibration target, refused (naming the field) when its picture cannot be drawn with every
+    edge on a texel boundary within the texture size limit (:mod:`scenegen.assets.board_raster`)."""
     f = node.as_mapping("a calibration target (a mapping with 'type')")
+    target = _read_target(f)
+    try:
+        texels_per_unit(layout_of(target))
+    except BoardRasterError as e:
+        raise (f.get(e.field) or node).error(str(e)) from None
+    return target
+
+
+def _read_target(f: Fields) -> mg.Target:
     kind = f.req("type").as_enum(mg.TARGET_KINDS, "target type")
     if kind == "checkerboard":
         C = mg.CheckerboardTarget
@@ -106,7 +118,7 @@ def parse_target(node: Node) -> mg.Target:
     if kind == "charuco":
         C = mg.CharucoTarget
         f.check(required=("type", "squares_x", "squares_y", "square_m", "marker_m",
-                          "dictionary"), optional=("margin_m",))
+                          "dictionary"), optional=("margin_m", "legacy_pattern"))
         sx, sy = read_int(f, C, "squares_x"), read_int(f, C, "squares_y")
         square = read_float(f, C, "square_m")
         marker = read_float(f, C, "marker_m")
@@ -119,7 +131,8 @@ def parse_target(node: Node) -> mg.Target:
             raise dict_node.error(f"{dictionary} holds {mg.ARUCO_DICTIONARIES[dictionary]} "
                                   f"markers; a {sx}x{sy} ChArUco board needs {needed}")
         return C(squares_x=sx, squares_y=sy, square_m=square, marker_m=marker,
-                 dictionary=dictionary, margin_m=read_float(f, C, "margin_m", default=square))
+                 dictionary=dictionary, margin_m=read_float(f, C, "margin_m", default=square),
+                 legacy_pattern=read_bool(f, C, "legacy_pattern"))
     C = mg.ArucoGridTarget
     f.check(required=("type", "markers_x", "markers_y", "marker_m", "separation_m",
                       "dictionary"), optional=("first_id", "margin_m"))

@@ -116,6 +116,34 @@ class TestProjective:
         x_back = np.c_[X_tgt, np.ones(30)] @ P_back.T
         np.testing.assert_allclose(x_back[:, :2] / x_back[:, 2:], x_true[:, :2] / x_true[:, 2:], atol=1e-7)
 
+    @pytest.mark.parametrize("w_ratio", [1.5e-9, 0.0])
+    def test_point_near_the_plane_at_infinity_keeps_full_precision(self, w_ratio):
+        """One source point with w' at 1.5e-9 of the largest |w'| (or exactly at infinity): the
+        camera mapped into the truth frame is exact to rounding. Dividing by w before the Hartley
+        normalisation threw that point ~1e9 away and left the rotation off by 3e-7 .. 1.5e-6 deg."""
+        from recon_eval.metrics.dlt import score_projection_projective
+
+        worst = 0.0
+        for seed in range(5):
+            rng = np.random.default_rng(seed)
+            K = np.array([[800.0, 0.5, 320], [0, 790, 240], [0, 0, 1]])
+            R, t = Rotation.from_rotvec(rng.normal(size=3) * 0.3).as_matrix(), np.array([0.1, -0.2, 4.0])
+            X = rng.normal(size=(40, 3))
+            Xh = np.c_[X, np.ones(40)]
+            proj_from_truth = np.eye(4) + 0.3 * rng.normal(size=(4, 4))
+            r4 = proj_from_truth[3]  # move the plane at infinity onto point 0 (up to w_ratio)
+            r4 -= (r4 @ Xh[0] - w_ratio * np.abs(Xh @ r4).max()) / (Xh[0] @ Xh[0]) * Xh[0]
+            X_proj = Xh @ proj_from_truth.T
+            w = np.abs(X_proj[:, 3])
+            assert w.min() <= (2 * w_ratio + 1e-15) * w.max()
+            P_truth = K @ np.c_[R, t]
+            px = Xh @ P_truth.T
+            px = px[:, :2] / px[:, 2:]
+            s = score_projection_projective(P_truth @ np.linalg.inv(proj_from_truth), X_proj, X, K, (R, t), px)
+            worst = max(worst, s.rot_err_deg)
+            assert s.reproj_rms_px < 1e-9 and s.fx_rel_err < 1e-12
+        assert worst < 1e-11, worst  # measured <= 2.3e-13 deg
+
     def test_too_few_points(self):
         with pytest.raises(InputError, match=">= 5"):
             projective_align(np.zeros((4, 3)), np.zeros((4, 3)))

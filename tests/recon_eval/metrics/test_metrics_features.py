@@ -104,6 +104,65 @@ def test_subpixel_shift_shows_up_exactly_in_localisation_error():
     assert repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=0.49).repeatability == 0.0
 
 
+def superpoint_reference(true_warped, warped, thresh):
+    """rpautrat/SuperPoint superpoint/evaluations/detector_evaluation.py, compute_repeatability's
+    counting, on keypoints already restricted to the shared region (x, y order); plus the mean of
+    the nearest distances within the threshold (both counts)."""
+    N1, N2 = len(true_warped), len(warped)
+    norm = np.linalg.norm(true_warped[:, None, :] - warped[None, :, :], axis=2)
+    count1 = count2 = 0
+    if N2 != 0:
+        min1 = np.min(norm, axis=1)
+        count1 = np.sum(min1 <= thresh)
+    if N1 != 0:
+        min2 = np.min(norm, axis=0)
+        count2 = np.sum(min2 <= thresh)
+    d = np.r_[min1[min1 <= thresh], min2[min2 <= thresh]]
+    return (count1 + count2) / (N1 + N2), np.mean(d)
+
+
+def test_superpoint_definition_is_the_reference_code():
+    """Both sets restricted to the shared region, distances in j: the reference's numbers exactly,
+    on a homography pair with an occluded box (keypoints of both views there have no truth)."""
+    map_ij, map_ji = homography_maps()
+    kp_i = random_keypoints(300, 3)
+    m, ok = map_keypoints(kp_i, map_ij)
+    rng = np.random.default_rng(4)
+    kp_j = np.vstack([m[ok][::2] + rng.normal(0, 0.6, size=(len(m[ok][::2]), 2)), random_keypoints(120, 5)])
+    r = repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0, definition="superpoint")
+    okj = map_keypoints(kp_j, map_ji)[1]
+    rep, loc = superpoint_reference(m[ok], kp_j[okj], 3.0)
+    assert r.definition == "superpoint" and (r.n_i, r.n_j) == (ok.sum(), okj.sum())
+    assert r.repeatability == pytest.approx(rep, abs=1e-15) and r.localisation_err_px == pytest.approx(loc, abs=1e-12)
+    assert repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0).definition == "all_keypoints"  # the default
+    with pytest.raises(InputError, match="definition must be one of"):
+        repeatability(kp_i, kp_j, map_ij, map_ji, definition="hpatches")
+
+
+def test_the_definitions_differ_on_a_keypoint_outside_the_shared_region():
+    """A keypoint of j without truth in i (outside i's frame) next to a mapped keypoint of i: the
+    default finds it, SuperPoint's restriction to the shared region does not."""
+    map_ij, map_ji = translation_maps()  # j = i + (7, 3): j's columns < 7 are outside i
+    kp_i = np.array([[0.5, 20.0], [30.0, 30.0]])  # map to (7.5, 23) and (37, 33) in j
+    kp_j = np.array([[6.2, 23.0], [37.0, 33.0]])  # (6.2, 23) maps to (-0.8, 20): no truth in i
+    a = repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0)
+    b = repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0, definition="superpoint")
+    assert (a.n_i, a.n_j) == (b.n_i, b.n_j) == (2, 1)
+    assert a.repeated_i == 2 and a.repeatability == 1.0  # (2 + 1) / 3
+    assert b.repeated_i == 1 and b.repeatability == pytest.approx(2 / 3)
+    assert b.localisation_err_px == 0.0 and a.localisation_err_px == pytest.approx(1.3 / 3)
+
+
+def test_the_reference_measures_j_keypoints_in_j():
+    """A zoom by 2 (j = 2 i): a keypoint of j 4 px (in j) from the mapped keypoint of i is 2 px from
+    it in i. The default measures j's keypoints in i (repeated at eps 3), the reference in j (not)."""
+    map_ij, map_ji = map_from(lambda x: 2 * x), map_from(lambda x: x / 2)
+    kp_i, kp_j = np.array([[10.0, 10.0]]), np.array([[24.0, 20.0]])  # i -> (20, 20); j -> (12, 10)
+    a = repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0)
+    b = repeatability(kp_i, kp_j, map_ij, map_ji, eps_px=3.0, definition="superpoint")
+    assert (a.repeated_i, a.repeated_j) == (0, 1) and (b.repeated_i, b.repeated_j) == (0, 0)
+
+
 def test_mma_on_hand_built_matches():
     map_ij, _ = translation_maps()
     occ = map_ij.state.copy()

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from scenegen.assets import targets
+from scenegen.assets.board_raster import aruco_dictionary
 
 # Detection on the clean, axis-aligned board picture (no rendering): the corners lie exactly on
 # pixel edges, so cornerSubPix / the ChArUco interpolation land within hundredths of a pixel
@@ -24,7 +25,7 @@ def _subpix(img, corners):
 def _aruco_detector(dictionary):
     params = cv2.aruco.DetectorParameters()
     params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
-    return cv2.aruco.ArucoDetector(targets._dictionary(dictionary), params)
+    return cv2.aruco.ArucoDetector(aruco_dictionary(dictionary), params)
 
 
 class TestCheckerboard:
@@ -137,6 +138,25 @@ class TestCharuco:
             targets.charuco_board(12, 12, 0.04, 0.03, dictionary="DICT_4X4_50")
 
 
+def test_legacy_charuco_layout_is_detected_by_a_legacy_board():
+    """OpenCV's legacy layout (even squares_y: the top-left square white): our truth, the picture
+    and cv2_board() agree, and a detector built without the legacy flag does not find it."""
+    b = targets.charuco_board(6, 4, 0.04, 0.032, dictionary="DICT_5X5_100", px_per_square=100,
+                              legacy_pattern=True)
+    m = int(round(b.margin_m * b.px_per_m))
+    assert b.image[m + 1, m + 1] == 255  # top-left square white (current layout: black)
+    cvb = b.cv2_board()
+    assert cvb.getLegacyPattern()
+    assert np.allclose(b.marker_corners_board - [b.margin_m, b.margin_m, 0], np.asarray(cvb.getObjPoints()), atol=1e-7)
+    corners, ids, _, _ = cv2.aruco.CharucoDetector(cvb).detectBoard(b.image)
+    assert ids is not None and len(ids) == len(b.point_ids)
+    truth = dict(zip(b.point_ids, b.points_image_px()))
+    err = np.linalg.norm(corners.reshape(-1, 2) - np.stack([truth[i] for i in ids.ravel()]), axis=1)
+    assert err.max() < CORNER_TOL_PX
+    current = targets.charuco_board(6, 4, 0.04, 0.032, dictionary="DICT_5X5_100", px_per_square=100)
+    assert current.image[m + 1, m + 1] == 0 and not np.array_equal(current.image, b.image)
+
+
 class TestArucoGrid:
     def test_detector_finds_truth(self):
         b = targets.aruco_grid(4, 3, marker_m=0.04, separation_m=0.01, px_per_marker=80)
@@ -158,7 +178,7 @@ class TestArucoGrid:
 
 @pytest.mark.parametrize("make", [
     lambda: targets.checkerboard_board(5, 4, 0.03, px_per_square=30),
-    lambda: targets.charuco_board(5, 4, 0.04, 0.03, px_per_square=60),
+    lambda: targets.charuco_board(5, 4, 0.04, 0.03, px_per_square=64),
     lambda: targets.aruco_grid(3, 2, 0.04, 0.01, px_per_marker=40),
 ])
 class TestMeshAndTexture:
@@ -209,7 +229,7 @@ def test_opencv_calibration_convention():
 
 class TestSpecIntegration:
     def test_object_from_board_centres_and_faces_plus_z(self):
-        b = targets.charuco_board(5, 4, 0.04, 0.03, px_per_square=60)
+        b = targets.charuco_board(5, 4, 0.04, 0.03, px_per_square=64)
         T = b.object_from_board()
         mesh = b.mesh()
         v_obj = T.apply(mesh.vertices)

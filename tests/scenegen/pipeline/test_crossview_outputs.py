@@ -222,7 +222,7 @@ def test_board_truth_charuco_markers_and_back_side():
     from scenegen.geometry.camera import Camera
     from scenegen.geometry.pose import Rigid3
 
-    board = charuco_board(5, 4, 0.04, 0.03, px_per_square=20)
+    board = charuco_board(5, 4, 0.04, 0.03, px_per_square=24)  # markers 3 px into their squares
     cam = Camera("opencv", 320, 240, 300.0, 300.0, 159.5, 119.5, 0.0, (-0.1, 0.01, 0, 0))
     # the print faces the board's -z: a camera at z = -0.5 looking along +z sees it upright
     cam_from_board = Rigid3(np.eye(3), [-board.width_m / 2, -board.height_m / 2, 0.5])

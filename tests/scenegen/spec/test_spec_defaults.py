@@ -81,6 +81,10 @@ CASES = [
      "objects:\n  - name: o\n    target: {type: aruco_grid, markers_x: 2, markers_y: 2, "
      "marker_m: 0.05, separation_m: 0.01, dictionary: DICT_4X4_50}\n",
      lambda s: s.objects[0].geometry.first_id, 3),
+    (m.CharucoTarget, "legacy_pattern",
+     "objects:\n  - name: o\n    target: {type: charuco, squares_x: 5, squares_y: 4, "
+     "square_m: 0.04, marker_m: 0.032, dictionary: DICT_4X4_50}\n",
+     lambda s: s.objects[0].geometry.legacy_pattern, True),
     (m.Transform, "scale", "objects:\n  - {name: o, shape: sphere, transform: {}}\n",
      lambda s: s.objects[0].transform.scale, (2.0, 2.0, 2.0)),
     (m.AreaLight, "size", "lights:\n  - {type: area, position: [0, 0, 2], look_at: [0, 0, 0], "
