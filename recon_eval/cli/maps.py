@@ -10,7 +10,7 @@ import numpy as np
 from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.depth import eigen_depth_metrics
+from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
 from recon_eval.metrics.stereo import eth3d_two_view, kitti_d1, middlebury
 from recon_eval.readers.kitti_png import read_kitti_obj_map
 from recon_eval.readers.registry import find_view_map, read_map
@@ -75,9 +75,16 @@ def depth_arguments(p) -> None:
     p.add_argument("gt", help="truth depth (.npy, .pfm, .exr), metres, or a dataset folder (truth/<view>.exr depth_z)")
     p.add_argument("--view", action="append", help="dataset truth: view(s) to score (default: all; a single "
                                                    "estimate file needs exactly one)")
-    p.add_argument("--alignment", choices=["none", "median", "scale_shift"], default="none")
-    p.add_argument("--min-depth", type=float, default=0.0)
-    p.add_argument("--max-depth", type=float, default=float("inf"))
+    p.add_argument("--alignment", choices=[a.value for a in DepthAlignment], default="none",
+                   help="scale_shift_inverse: least squares in inverse depth, as MiDaS / DPT")
+    p.add_argument("--min-depth", type=float, default=0.0, help="truth used where min < g < max (monodepth2: 1e-3)")
+    p.add_argument("--max-depth", type=float, default=float("inf"), help="(monodepth2 on KITTI: 80)")
+    p.add_argument("--no-clamp", action="store_true",
+                   help="do not clamp the aligned predictions to [min-depth, max-depth] (monodepth2 does)")
+    p.add_argument("--crop", choices=sorted(CROPS), help="evaluation crop: garg (monodepth2's) or eigen (BTS's)")
+    p.add_argument("--pred-inverse", action="store_true",
+                   help="the prediction is inverse depth up to scale and shift (MiDaS / DPT output); "
+                        "needs --alignment scale_shift_inverse")
 
 
 def _dataset_depths(a, ds):
@@ -115,15 +122,23 @@ def score_depth(a):
         est_list, gt_list, missing, gt_kind = [read_map(a.est, "depth")], [read_map(a.gt, "depth")], [], "file"
         same_shape(est_list[0], gt_list[0], a.est, a.gt)
     res = {"eigen": eigen_depth_metrics(est_list, gt_list, alignment=a.alignment,
-                                        min_depth_m=a.min_depth, max_depth_m=a.max_depth)}
+                                        min_depth_m=a.min_depth, max_depth_m=a.max_depth, clamp=not a.no_clamp,
+                                        crop=a.crop, pred_is_inverse=a.pred_inverse)}
     inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "views": names, "views_without_estimate": missing,
-              "alignment": a.alignment}
+              "alignment": a.alignment, "clamp": not a.no_clamp, "crop": a.crop, "pred_inverse": a.pred_inverse}
 
     def figures():
         r = res["eigen"]
         figs, rel = [], {}
         for k, (e, g) in enumerate(zip(est_list, gt_list)):
-            e_al = r.per_image_scale[k] * e + r.per_image_shift_m[k]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                if r.per_image_shift_inv_m is not None:  # aligned in inverse depth
+                    q = e if a.pred_inverse else 1.0 / e
+                    e_al = 1.0 / np.maximum(r.per_image_scale[k] * q + r.per_image_shift_inv_m[k], 1.0 / a.max_depth)
+                else:
+                    e_al = r.per_image_scale[k] * e + r.per_image_shift_m[k]
+                if r.clamp:
+                    e_al = np.clip(e_al, a.min_depth, a.max_depth)
             label = names[k] if names else Path(a.est).name
             if k < 8:
                 figs.append(Figure(f"Depth error: {label}",

@@ -5,8 +5,8 @@ Every test here measures the largest difference between recon_eval's number and 
 algorithm transcribed in the test with the source named) and records it with the ``agreement``
 fixture. The table between the markers in docs/metrics.md is made from these records:
 
-* ``RECON_EVAL_WRITE_AGREEMENT=1 pytest tests/recon_eval/agreement`` rewrites it (run the whole
-  folder: rows are kept in the order recorded);
+* ``RECON_EVAL_WRITE_AGREEMENT=1 pytest tests/recon_eval/agreement`` rewrites the rows it
+  measured (others are kept, new ones appended);
 * otherwise every test checks that its row is in the table and that the measured difference is
   at most the documented one (so the table stays what the tests measure).
 """
@@ -69,12 +69,26 @@ def agreement():
     return record
 
 
+def _table_lines(text: str) -> dict[str, str]:
+    if BEGIN not in text:
+        return {}
+    body = text.split(BEGIN, 1)[1].split(END, 1)[0]
+    out = {}
+    for line in body.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 5 and cells[0] not in ("id", "---"):
+            out[cells[0].strip("`")] = line
+    return out
+
+
 def pytest_sessionfinish(session, exitstatus):
     if not os.environ.get("RECON_EVAL_WRITE_AGREEMENT") or not _ROWS:
         return
-    rows = "\n".join(f"| `{k}` | {m} | {r} | {w} | {b} |" for k, (m, r, w, b) in _ROWS.items())
     text = DOC.read_text(encoding="utf-8")
-    block = f"{BEGIN}\n{HEADER}\n{rows}\n{END}"
+    lines = _table_lines(text)
+    for k, (m, r, w, b) in _ROWS.items():
+        lines[k] = f"| `{k}` | {m} | {r} | {w} | {b} |"
+    block = f"{BEGIN}\n{HEADER}\n" + "\n".join(lines.values()) + f"\n{END}"
     if BEGIN in text:
         text = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, text, flags=re.S)
     else:
