@@ -3,6 +3,7 @@ dataset's truth (docs/metrics.md, "Stereo disparity", "Depth maps"). Map formats
 :func:`recon_eval.readers.registry.read_map`."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ from recon_eval.errors import InputError
 from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
 from recon_eval.metrics.stereo import eth3d_two_view, kitti_d1, middlebury
 from recon_eval.readers.kitti_png import read_kitti_obj_map
+from recon_eval.readers.middlebury import CALIB, is_middlebury_mask, middlebury_ndisp, read_middlebury_mask
 from recon_eval.readers.registry import find_view_map, read_map
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report import plots
@@ -25,9 +27,15 @@ def disparity_arguments(p) -> None:
     p.add_argument("gt", help="truth disparity (occ / all pixels), or a dataset folder with --view")
     p.add_argument("--view", help="dataset truth: the left view of a rectified stereo pair")
     p.add_argument("--right-view", help="dataset truth: its right view (default: the other member of the rig)")
-    p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr)")
+    p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr; "
+                                    "a Middlebury mask0nocc.png: 255 = evaluated)")
     p.add_argument("--obj-map", help="KITTI foreground map PNG")
     p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti")
+    p.add_argument("--ndisp", type=float, help="Middlebury: clip estimates to [0, NDISP] as evaldisp does (default: "
+                                               "ndisp of the calib.txt beside the truth file; for a dataset truth "
+                                               "the export's max(16, 16 ceil(max d / 16)))")
+    p.add_argument("--calib", help="Middlebury calib.txt giving ndisp (default: calib.txt beside the truth)")
+    p.add_argument("--round-disp", action="store_true", help="Middlebury evaldisp's rounddisp: round the estimates")
 
 
 def score_disparity(a):
@@ -42,16 +50,24 @@ def score_disparity(a):
         needs_dataset_for_view(a)
         gt = read_map(a.gt, "disparity")
     same_shape(est, gt, a.est, a.gt)
-    noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    mask = None
+    if a.gt_noc and a.benchmark != "kitti" and is_middlebury_mask(a.gt_noc):
+        mask, noc = read_middlebury_mask(a.gt_noc), None
+    else:
+        noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
+              "benchmark": a.benchmark}
     if a.benchmark == "kitti":
         obj = [read_kitti_obj_map(a.obj_map)] if a.obj_map else None
         res = {"kitti_d1": kitti_d1([est], [gt], None if noc is None else [noc], obj)}
+    elif a.benchmark == "middlebury":
+        mask = mask if noc is None else np.isfinite(noc)
+        ndisp, source = _middlebury_ndisp(a, gt, gt_kind != "file")
+        inputs.update(ndisp=ndisp, ndisp_source=source)
+        res = {"middlebury": middlebury(est, gt, mask, ndisp=ndisp, round_disp=a.round_disp)}
     else:
-        mask = None if noc is None else np.isfinite(noc)
-        fn = middlebury if a.benchmark == "middlebury" else eth3d_two_view
-        res = {a.benchmark: fn(est, gt, mask)}
-    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
-              "benchmark": a.benchmark}
+        mask = mask if noc is None else np.isfinite(noc)
+        res = {"eth3d": eth3d_two_view(est, gt, mask)}
 
     def figures():
         e = np.abs(est - gt)
@@ -66,6 +82,22 @@ def score_disparity(a):
         ]
 
     return inputs, res, figures
+
+
+def _middlebury_ndisp(a, gt, dataset_truth: bool):
+    """(ndisp, where it came from) for Middlebury's clipping of the estimates."""
+    if a.ndisp is not None:
+        return a.ndisp, "--ndisp"
+    if a.calib:
+        return middlebury_ndisp(a.calib), a.calib
+    if dataset_truth:  # what scenegen's Middlebury export writes into calib.txt for this truth
+        fin = gt[np.isfinite(gt)]
+        vmax = float(fin.max()) if fin.size else 0.0
+        return float(max(16, 16 * math.ceil(vmax / 16))), "dataset truth: max(16, 16 ceil(max d / 16)) as the export"
+    calib = Path(a.gt).parent / CALIB
+    if calib.is_file():
+        return middlebury_ndisp(calib), str(calib)
+    return None, f"none: no {CALIB} beside the truth, estimates not clipped (evaldisp clips to ndisp; pass --calib)"
 
 
 # --- depth ------------------------------------------------------------------------------------
