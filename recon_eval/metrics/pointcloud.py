@@ -4,7 +4,8 @@ Definitions: shared/notes/metrics.md, "Point clouds and meshes" (reproduced in d
 All clouds are (N, 3) float64 in metres, already in the truth frame (align first with
 :mod:`recon_eval.metrics.align`; the result's ``alignment`` field is whatever the caller declares).
 
-Distances rec -> GT go to the GT mesh surface when ``gt_mesh=(vertices, faces)`` is given (exact
+Distances rec -> GT go to the GT mesh surface when ``gt_mesh=(vertices, faces)`` (or a
+:class:`recon_eval.metrics.distances.MeshSurface`, built once for several metrics) is given (exact
 point-to-triangle) and to the nearest GT point otherwise; distances GT -> rec always go to the
 nearest reconstructed point (a reconstruction is a cloud). ``distance_rec_to_gt`` says which.
 """
@@ -16,7 +17,7 @@ import numpy as np
 
 from recon_eval.arrays import as_float_array
 from recon_eval.errors import InputError
-from recon_eval.metrics.distances import DistanceTo, mesh_surface_distances, nearest_point_distances
+from recon_eval.metrics.distances import DistanceTo, nearest_point_distances, surface_distances
 
 
 def voxel_downsample(points, voxel_m: float) -> np.ndarray:
@@ -59,8 +60,7 @@ def _check_cloud(points, name: str) -> np.ndarray:
 
 def _rec_to_gt(rec: np.ndarray, gt: np.ndarray, gt_mesh) -> tuple[np.ndarray, DistanceTo]:
     if gt_mesh is not None:
-        vertices, faces = gt_mesh
-        return mesh_surface_distances(rec, vertices, faces), DistanceTo.MESH
+        return surface_distances(rec, gt_mesh), DistanceTo.MESH
     return nearest_point_distances(rec, gt), DistanceTo.POINTS
 
 
@@ -140,7 +140,7 @@ def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=
         to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
         return np.full(len(rec), np.inf), np.full(len(gt), np.inf), voxel, to.value
     if gt_mesh is not None:
-        d_rg, to = mesh_surface_distances(rec, *gt_mesh), DistanceTo.MESH
+        d_rg, to = surface_distances(rec, gt_mesh), DistanceTo.MESH
     else:
         d_rg, to = nearest_point_distances(rec, gt, upper_bound_m=upper_bound_m), DistanceTo.POINTS
     d_gr = nearest_point_distances(gt, rec, upper_bound_m=upper_bound_m)
