@@ -64,8 +64,7 @@ def score_calibration(a):
 
     def figures():
         figs = []
-        for key, what in (("projection_diff", "intrinsics only"), ("projection_diff_rotation_fitted", "rotation fitted"),
-                          ("mrcal_projection_diff", "mrcal: rotation fitted in the focus region")):
+        for key, what in (("projection_diff", "intrinsics only"), ("projection_diff_rotation_fitted", "rotation fitted")):
             r = res[key]
             figs.append(Figure(f"Projection difference ({what})",
                                plots.field_figure(r.diff_px, r.grid_u_px, r.grid_v_px, unit="px",

@@ -214,6 +214,37 @@ def eth3d(
     )
 
 
+#: ETH3D's tolerance table (multi-view-evaluation: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m).
+ETH3D_TOLERANCES_M = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5)
+
+
+def eth3d_table(points_rec, points_gt, tolerances_m=ETH3D_TOLERANCES_M, *, gt_mesh=None, rec_observed=None,
+                voxel_m: float = 0.01) -> tuple[Eth3dResult, ...]:
+    """:func:`eth3d` at every tolerance (ETH3D evaluates its whole table at once), the distances
+    computed once. Identical to calling :func:`eth3d` per tolerance."""
+    rec = _check_cloud(points_rec, "reconstructed points")
+    gt = _check_cloud(points_gt, "GT points")
+    tols = tuple(float(t) for t in tolerances_m)
+    if not tols or not all(t > 0 for t in tols) or not voxel_m > 0:
+        raise InputError("tolerances and voxel size must be > 0 metres")
+    observed = np.ones(len(rec), bool) if rec_observed is None else np.asarray(rec_observed, bool).reshape(-1)
+    if observed.shape != (len(rec),):
+        raise InputError(f"rec_observed: expected shape ({len(rec)},), got {observed.shape}")
+    rec_s = rec[observed]
+    to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
+    n_un = int((~observed).sum())
+    if len(rec_s) == 0 or len(gt) == 0:
+        return tuple(Eth3dResult(t, 0.0, 0.0, 0.0, voxel_m, len(rec_s), n_un, len(gt), to.value) for t in tols)
+    d_rg, to = _rec_to_gt(rec_s, gt, gt_mesh)
+    d_gr = nearest_point_distances(gt, rec_s, upper_bound_m=max(tols) * (1.0 + _BOUND_SLACK))
+    out = []
+    for t in tols:
+        acc = _voxel_average(rec_s, d_rg <= t, voxel_m)
+        comp = _voxel_average(gt, d_gr <= t, voxel_m)
+        out.append(Eth3dResult(t, acc, comp, _fscore(acc, comp), voxel_m, len(rec_s), n_un, len(gt), to.value))
+    return tuple(out)
+
+
 # --- DTU ---------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class DtuResult:
