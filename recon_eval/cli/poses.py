@@ -8,6 +8,7 @@ from pathlib import PurePosixPath
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.poses import DELTA_UNITS, POSE_ALIGNMENTS, Poses, ape, relative_pose, rpe
+from recon_eval.metrics.kitti_odometry import KITTI_LENGTHS_M, kitti_odometry
 from recon_eval.readers.registry import read_poses
 from recon_eval.readers.tum import associate
 from recon_eval.report import plots
@@ -34,6 +35,8 @@ def arguments(p) -> None:
                    help="RPE across an unregistered camera: bridge = pair the registered poses as evo does "
                         "(default; broken truth-frame pairs still counted as failures), fail = no bridging")
     p.add_argument("--max-time-diff", type=float, default=0.01, help="TUM timestamp association, seconds")
+    p.add_argument("--kitti-lengths", type=float, nargs="+", metavar="M",
+                   help="KITTI odometry segment lengths, metres (default the devkit's 100 200 ... 800)")
     p.add_argument("--camera", help="dataset truth: only the views of this spec camera (e.g. the left camera of a "
                                     "KITTI-style trajectory)")
     p.add_argument("--kitti-convention", choices=["world_from_cam", "cam_from_world"], default="world_from_cam",
@@ -81,7 +84,8 @@ def score(a):
     res = {"ape": ape(est, gt, alignment=al, n_to_align=a.n_to_align),
            "rpe": rpe(est, gt, delta=delta, delta_unit=a.delta_unit, all_pairs=a.all_pairs, alignment=al,
                       n_to_align=a.n_to_align, gaps=a.rpe_gaps),
-           "relative_pose": relative_pose(est, gt)}
+           "relative_pose": relative_pose(est, gt),
+           "kitti_odometry": kitti_odometry(est, gt, lengths_m=a.kitti_lengths or KITTI_LENGTHS_M)}
     inputs = {"est": a.est, "gt": a.gt, "format": ek, "gt_format": gk, "matching": matching,
               "alignment": a.alignment, "delta_frames": delta if a.delta_unit == "f" else None, "camera": a.camera,
               "delta": delta, "delta_unit": a.delta_unit, "all_pairs": a.all_pairs, "n_to_align": a.n_to_align,
