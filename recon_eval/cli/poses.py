@@ -3,16 +3,21 @@ readers registry sniffs (:func:`recon_eval.readers.registry.read_poses`; docs/me
 "Camera poses")."""
 from __future__ import annotations
 
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.poses import DELTA_UNITS, POSE_ALIGNMENTS, Poses, ape, relative_pose, rpe
 from recon_eval.metrics.kitti_odometry import KITTI_LENGTHS_M, kitti_odometry
+from recon_eval.metrics.sfm import reconstruction_stats
+from recon_eval.readers.colmap_binary import read_colmap_binary
+from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.readers.registry import read_poses
 from recon_eval.readers.tum import associate
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
 
 def arguments(p) -> None:
@@ -58,6 +63,23 @@ def match_names_by_stem(est: Poses, gt: Poses) -> tuple[Poses, bool]:
     return (Poses(tuple(names), est.R_cam_from_world, est.t_cam_from_world) if renamed else est), renamed
 
 
+def colmap_model_stats(model_dir):
+    """COLMAP's mean reprojection error and track length of the model in ``model_dir``
+    (:func:`recon_eval.metrics.sfm.reconstruction_stats`), or None for a model without tracks."""
+    d = Path(model_dir)
+    model = read_colmap_binary(d) if (d / "images.bin").is_file() else read_colmap_text(d)
+    if len(model.track_point) == 0:
+        return None
+    try:
+        cams = {cid: Camera.from_colmap(c.model, c.width, c.height, c.params_colmap) for cid, c in model.cameras.items()}
+        per_image = [cams[cid] for cid in model.image_camera_ids]
+    except (KeyError, ValueError) as exc:
+        raise InputError(f"{d}: cameras: {exc}") from None
+    return reconstruction_stats(per_image, model.poses.R_cam_from_world, model.poses.t_cam_from_world,
+                                model.points_world, model.track_point, model.track_image,
+                                opencv_from_colmap_pixels(model.track_xy_colmap))
+
+
 def score(a):
     ek, est = read_poses(a.est, camera=a.camera, kitti_convention=a.kitti_convention)
     gk, gt = read_poses(a.gt, camera=a.camera, kitti_convention=a.kitti_convention)
@@ -86,6 +108,8 @@ def score(a):
                       n_to_align=a.n_to_align, gaps=a.rpe_gaps),
            "relative_pose": relative_pose(est, gt),
            "kitti_odometry": kitti_odometry(est, gt, lengths_m=a.kitti_lengths or KITTI_LENGTHS_M)}
+    if ek == "colmap":
+        res["colmap_reconstruction"] = colmap_model_stats(a.est)
     inputs = {"est": a.est, "gt": a.gt, "format": ek, "gt_format": gk, "matching": matching,
               "alignment": a.alignment, "delta_frames": delta if a.delta_unit == "f" else None, "camera": a.camera,
               "delta": delta, "delta_unit": a.delta_unit, "all_pairs": a.all_pairs, "n_to_align": a.n_to_align,
