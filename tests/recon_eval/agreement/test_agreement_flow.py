@@ -109,7 +109,7 @@ def test_fl_equals_kitti_devkit(agreement):
                             - [pct("bg"), pct("fg"), pct("all"), pct("all_r")])))
     assert d == 0
     agreement("kitti.fl", "Fl bg/fg/all and the est row (%), a wholly invalid interior row",
-              "KITTI 2015 devkit `interpolateBackground`, `flowErrorsOutlier` (transcribed)", "devkit 1.0",
+              "KITTI 2015 devkit `interpolateBackground`, `flowErrorsOutlier` (transcribed)", "devkit_scene_flow (2015)",
               "32x20, 25 % holes", d)
 
 
@@ -169,4 +169,4 @@ def test_kitti_flow_png_and_flo_equal_the_formats(tmp_path, agreement):
     assert np.array_equal(decode_kitti_flow(png)[valid], ((png[valid, :2].astype(float) - 32768) / 64))
     agreement("flow.files", "KITTI flow PNG write / read and .flo read (px)",
               "KITTI devkit `writeFlowField` / `readFlowField`; Middlebury flow-code readme (transcribed)",
-              "devkit 1.0", "24x16 flow", d)
+              "devkit_scene_flow (2015)", "24x16 flow", d)

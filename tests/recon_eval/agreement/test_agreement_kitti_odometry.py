@@ -70,5 +70,5 @@ def test_t_err_r_err_equal_the_devkit(agreement):
             abs(r.r_err_deg_per_100m - np.degrees(r_ref) * 100) / (np.degrees(r_ref) * 100))
     assert d < 1e-9
     agreement("kitti.odometry", "t_err (%), r_err (deg/100 m), relative",
-              "KITTI odometry devkit `evaluate_odometry.cpp` (transcribed)", "devkit_odometry 1.0",
+              "KITTI odometry devkit `evaluate_odometry.cpp` (transcribed)", "devkit_odometry (2012)",
               "1400 frames, 1.5 km drive, drifting odometry", d)

@@ -107,7 +107,7 @@ def test_d1_equals_kitti_devkit(agreement):
     d = float(np.max(np.abs(np.array(ours) - ref)))
     assert d == 0
     agreement("kitti.d1", "D1 bg/fg/all and the est rows (%), wholly invalid interior rows",
-              "KITTI 2015 devkit `interpolateBackground`, `disparityErrorsOutlier` (transcribed)", "devkit 1.0",
+              "KITTI 2015 devkit `interpolateBackground`, `disparityErrorsOutlier` (transcribed)", "devkit_scene_flow (2015)",
               "40x24, 30 % holes, 3 empty interior rows", d)
 
 
@@ -171,7 +171,7 @@ def test_middlebury_equals_evaldisp(rounddisp, agreement):
     assert d < 1e-12
     agreement(f"middlebury.evaldisp{'.round' if rounddisp else ''}",
               f"bad 0.5/1/2/4, invalid, totbad (%), avgerr (px), all and nonocc mask{', rounddisp' if rounddisp else ''}",
-              "MiddEval3 `evaldisp.cpp` (transcribed)", "SDK 1.6", "44x30, 10 % holes, 10 % out of [0, ndisp]", d)
+              "MiddEval3 `evaldisp.cpp` (transcribed)", "MiddEval3 SDK (avgErr of 10/2014)", "44x30, 10 % holes, 10 % out of [0, ndisp]", d)
 
 
 def test_cli_reads_the_exports_mask_and_calib(tmp_path, agreement):
@@ -193,4 +193,4 @@ def test_cli_reads_the_exports_mask_and_calib(tmp_path, agreement):
     d = max(abs(r["bad_2_0_pct"] - ref[0]), abs(r["invalid_pct"] - ref[1]), abs(r["avgerr_px"] - ref[3]))
     assert d < 1e-9 and doc["inputs"]["ndisp"] == 64.0
     agreement("middlebury.cli_export_files", "bad 2.0, invalid (%), avgerr (px) from the export's mask0nocc.png "
-              "and calib.txt", "MiddEval3 `evaldisp.cpp` (transcribed)", "SDK 1.6", "44x30 PFM files", d)
+              "and calib.txt", "MiddEval3 `evaldisp.cpp` (transcribed)", "MiddEval3 SDK (avgErr of 10/2014)", "44x30 PFM files", d)
