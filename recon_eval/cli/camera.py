@@ -7,7 +7,8 @@ import numpy as np
 from recon_eval.cli.common import dataset_view, needs_dataset_for_view
 from recon_eval.cli.scored import no_figures, scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.calibration import intrinsics_errors, projection_difference, reprojection_rms
+from recon_eval.metrics.calibration import (intrinsics_errors, mrcal_projection_diff, projection_difference,
+                                            reprojection_rms)
 from recon_eval.metrics.pnp import pnp_errors
 from recon_eval.readers.npy import read_npy
 from recon_eval.readers.opencv_calib import read_opencv_calibration
@@ -23,7 +24,11 @@ def calibration_arguments(p) -> None:
     p.add_argument("gt", help="truth: a dataset folder (camera of --view) or an OpenCV YAML/JSON calibration")
     p.add_argument("--view", help="dataset truth: the view whose camera is the truth (default: the first view)")
     p.add_argument("--est-model", choices=["opencv", "fisheye"], help="override the estimate's distortion model")
-    p.add_argument("--grid", type=int, nargs=2, default=(60, 40), metavar=("NX", "NY"), help="projection-difference grid")
+    p.add_argument("--grid", type=int, nargs=2, metavar=("NX", "NY"),
+                   help="projection-difference grid (default 60 x 40; mrcal_projection_diff: mrcal's 60 x "
+                        "round(60 H / W))")
+    p.add_argument("--focus-radius", type=float, default=-1.0,
+                   help="mrcal_projection_diff: focus region radius in px (default min(W, H) / 6, as mrcal)")
     p.add_argument("--points", type=int, default=5000, help="dataset truth: held-out truth points for reprojection")
 
 
@@ -46,10 +51,13 @@ def score_calibration(a):
     if (gt.width, gt.height) != (est.width, est.height):
         raise InputError(f"{a.est}: image_width/image_height {est.width}x{est.height} differ from the truth's "
                          f"{gt.width}x{gt.height} ({a.gt})")
-    nx, ny = a.grid
+    nx, ny = a.grid or (60, 40)
     res = {"intrinsics": intrinsics_errors(est.K, gt.K),
            "projection_diff": projection_difference(gt, est, grid_nx=nx, grid_ny=ny),
-           "projection_diff_rotation_fitted": projection_difference(gt, est, grid_nx=nx, grid_ny=ny, fit_rotation=True)}
+           "projection_diff_rotation_fitted": projection_difference(gt, est, grid_nx=nx, grid_ny=ny, fit_rotation=True),
+           "mrcal_projection_diff": mrcal_projection_diff(gt, est, gridn_width=a.grid[0] if a.grid else 60,
+                                                          gridn_height=a.grid[1] if a.grid else None,
+                                                          focus_radius=a.focus_radius)}
     if held_out is not None:
         pose, X, uv = held_out
         res["reprojection_held_out"] = reprojection_rms(est, pose.R, pose.t, X, uv)

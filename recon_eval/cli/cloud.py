@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from recon_eval.cli.common import stderr_progress
 from recon_eval.cli.scored import scored
-from recon_eval.metrics.distances import sample_mesh_surface
-from recon_eval.metrics.pointcloud import chamfer, dtu, eth3d, tanks_and_temples, tanks_and_temples_distances
+from recon_eval.metrics.distances import MeshSurface, sample_mesh_surface
+from recon_eval.metrics.pointcloud import (ETH3D_TOLERANCES_M, chamfer, dtu, eth3d_table, tanks_and_temples,
+                                          tanks_and_temples_distances)
+from recon_eval.metrics.surfaces import mesh_comparison
+from recon_eval.metrics.tnt import crop_mask, tanks_and_temples_curves
+from recon_eval.readers.crop_volume import read_crop_volume
 from recon_eval.readers.ply import read_geometry
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report import plots
@@ -17,12 +22,19 @@ def arguments(p) -> None:
     p.add_argument("rec", help="reconstruction (.ply/.obj/.stl point cloud or mesh; its vertices are scored)")
     p.add_argument("gt", help="truth (.ply/.obj/.stl, or a dataset folder: its scene meshes); a mesh gives exact "
                               "point-to-triangle distances")
-    p.add_argument("--tau", type=float, action="append", help="threshold(s) in metres (default 0.01)")
+    p.add_argument("--tau", type=float, action="append", help="Tanks and Temples threshold(s) in metres (default 0.01)")
+    p.add_argument("--eth3d-tolerance", type=float, action="append",
+                   help="ETH3D tolerance(s) in metres (default ETH3D's table 0.01 0.02 0.05 0.1 0.2 0.5; each --tau "
+                        "is evaluated too)")
     p.add_argument("--gt-samples", type=int, default=200_000, help="surface samples of a GT mesh for recall/completeness")
     p.add_argument("--seed", type=int, default=0, help="seed of the GT mesh surface sample")
     p.add_argument("--no-downsample", action="store_true", help="skip Tanks and Temples' tau/2 voxel downsampling")
     p.add_argument("--eth3d-voxel", type=float, default=0.01, help="ETH3D per-voxel averaging size, metres")
     p.add_argument("--dtu-max-dist", type=float, default=0.02, help="DTU outlier cut, metres")
+    p.add_argument("--crop", metavar="JSON", help="Tanks and Temples crop volume (an Open3D SelectionPolygonVolume "
+                                                  "JSON): both clouds are cropped before scoring")
+    p.add_argument("--mesh-samples", type=int, default=100_000,
+                   help="mesh against mesh: Occupancy Networks' surface samples per mesh and IoU points")
 
 
 def score(a):
@@ -37,24 +49,41 @@ def score(a):
     mesh = None
     gt_pts = V
     if F is not None and len(F):
-        mesh = (V, F)
+        mesh = MeshSurface(V, F, progress=stderr_progress("distances to the GT mesh"))
         gt_pts = sample_mesh_surface(V, F, a.gt_samples, seed=a.seed)
+    rec_pts = rec.vertices
+    crop = None
+    if a.crop:
+        crop = read_crop_volume(a.crop)
+        rec_pts, gt_pts = rec_pts[crop_mask(rec_pts, crop)], gt_pts[crop_mask(gt_pts, crop)]
     taus = a.tau or [0.01]
+    tols = tuple(sorted(set(a.eth3d_tolerance or ETH3D_TOLERANCES_M) | set(taus)))
     res = {}
     for tau in taus:
-        res[f"tanks_and_temples@{tau:g}m"] = tanks_and_temples(rec.vertices, gt_pts, tau, gt_mesh=mesh,
+        res[f"tanks_and_temples@{tau:g}m"] = tanks_and_temples(rec_pts, gt_pts, tau, gt_mesh=mesh,
                                                               downsample=not a.no_downsample)
-        res[f"eth3d@{tau:g}m"] = eth3d(rec.vertices, gt_pts, tau, gt_mesh=mesh, voxel_m=a.eth3d_voxel)
-    res["dtu"] = dtu(rec.vertices, gt_pts, max_dist_m=a.dtu_max_dist, gt_mesh=mesh)
-    res["chamfer"] = chamfer(rec.vertices, gt_pts, gt_mesh=mesh)
+    for r in eth3d_table(rec_pts, gt_pts, tols, gt_mesh=mesh, voxel_m=a.eth3d_voxel):
+        res[f"eth3d@{r.tolerance_m:g}m"] = r
+    res["dtu"] = dtu(rec_pts, gt_pts, max_dist_m=a.dtu_max_dist, gt_mesh=mesh)
+    res["chamfer"] = chamfer(rec_pts, gt_pts, gt_mesh=mesh)
+    curves = {}
+    for tau in taus:
+        d_rg, d_gr, _, _ = tanks_and_temples_distances(rec_pts, gt_pts, tau, gt_mesh=mesh,
+                                                       downsample=not a.no_downsample)
+        curves[tau] = (d_rg, d_gr)
+        res[f"tanks_and_temples_curves@{tau:g}m"] = tanks_and_temples_curves(d_rg, d_gr, tau)
+    if mesh is not None and rec.faces is not None and len(rec.faces):
+        res["occupancy_networks"] = mesh_comparison(rec.vertices, rec.faces, V, F, n_samples=a.mesh_samples,
+                                                    n_iou_points=a.mesh_samples, seed=a.seed)
     inputs = {"rec": a.rec, "gt": a.gt, "gt_kind": gt_kind, "gt_is_mesh": mesh is not None,
               "gt_points": "mesh surface sample" if mesh is not None else "file vertices",
-              "gt_samples": a.gt_samples if mesh is not None else None, "seed": a.seed, "tau_m": taus}
+              "gt_samples": a.gt_samples if mesh is not None else None, "seed": a.seed, "tau_m": taus,
+              "eth3d_tolerances_m": list(tols), "crop": a.crop,
+              "n_rec_cropped": None if crop is None else len(rec_pts), "n_gt_cropped": None if crop is None else len(gt_pts)}
 
     def figures():
         tau = taus[0]
-        d_rg, d_gr, _, _ = tanks_and_temples_distances(rec.vertices, gt_pts, tau, gt_mesh=mesh,
-                                                       downsample=not a.no_downsample)
+        d_rg, d_gr = curves[tau]
         ts = np.linspace(0.0, 5.0 * max(taus), 201)[1:]
         return [
             Figure("Precision / recall / F-score vs tau",

@@ -1,6 +1,9 @@
 """Small helpers the command families share: the dataset view a command scores, shape checks."""
 from __future__ import annotations
 
+import sys
+import time
+
 from recon_eval.errors import InputError
 
 
@@ -24,3 +27,20 @@ def needs_dataset_for_view(a) -> None:
     """``--view`` only names a view of a dataset truth."""
     if a.view:
         raise InputError(f"--view needs a dataset truth; {a.gt} is not a dataset folder")
+
+
+def stderr_progress(what: str, *, every_s: float = 2.0):
+    """``progress(done, total)`` printing ``recon-eval: <what>: done/total`` on stderr at most every
+    ``every_s`` seconds, and the last line when the whole took longer than that (short runs print
+    nothing)."""
+    start = last = time.monotonic()
+
+    def progress(done: int, total: int) -> None:
+        nonlocal last
+        now = time.monotonic()
+        if now - last >= every_s or (done >= total and now - start >= every_s):
+            print(f"recon-eval: {what}: {done:,}/{total:,} ({100.0 * done / max(total, 1):.0f} %, "
+                  f"{now - start:.1f} s)", file=sys.stderr, flush=True)
+            last = now
+
+    return progress

@@ -3,6 +3,7 @@ dataset's truth (docs/metrics.md, "Stereo disparity", "Depth maps"). Map formats
 :func:`recon_eval.readers.registry.read_map`."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -10,9 +11,10 @@ import numpy as np
 from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.depth import eigen_depth_metrics
+from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
 from recon_eval.metrics.stereo import eth3d_two_view, kitti_d1, middlebury
 from recon_eval.readers.kitti_png import read_kitti_obj_map
+from recon_eval.readers.middlebury import CALIB, is_middlebury_mask, middlebury_ndisp, read_middlebury_mask
 from recon_eval.readers.registry import find_view_map, read_map
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report import plots
@@ -25,9 +27,15 @@ def disparity_arguments(p) -> None:
     p.add_argument("gt", help="truth disparity (occ / all pixels), or a dataset folder with --view")
     p.add_argument("--view", help="dataset truth: the left view of a rectified stereo pair")
     p.add_argument("--right-view", help="dataset truth: its right view (default: the other member of the rig)")
-    p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr)")
+    p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr; "
+                                    "a Middlebury mask0nocc.png: 255 = evaluated)")
     p.add_argument("--obj-map", help="KITTI foreground map PNG")
     p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti")
+    p.add_argument("--ndisp", type=float, help="Middlebury: clip estimates to [0, NDISP] as evaldisp does (default: "
+                                               "ndisp of the calib.txt beside the truth file; for a dataset truth "
+                                               "the export's max(16, 16 ceil(max d / 16)))")
+    p.add_argument("--calib", help="Middlebury calib.txt giving ndisp (default: calib.txt beside the truth)")
+    p.add_argument("--round-disp", action="store_true", help="Middlebury evaldisp's rounddisp: round the estimates")
 
 
 def score_disparity(a):
@@ -42,16 +50,24 @@ def score_disparity(a):
         needs_dataset_for_view(a)
         gt = read_map(a.gt, "disparity")
     same_shape(est, gt, a.est, a.gt)
-    noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    mask = None
+    if a.gt_noc and a.benchmark != "kitti" and is_middlebury_mask(a.gt_noc):
+        mask, noc = read_middlebury_mask(a.gt_noc), None
+    else:
+        noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
+              "benchmark": a.benchmark}
     if a.benchmark == "kitti":
         obj = [read_kitti_obj_map(a.obj_map)] if a.obj_map else None
         res = {"kitti_d1": kitti_d1([est], [gt], None if noc is None else [noc], obj)}
+    elif a.benchmark == "middlebury":
+        mask = mask if noc is None else np.isfinite(noc)
+        ndisp, source = _middlebury_ndisp(a, gt, gt_kind != "file")
+        inputs.update(ndisp=ndisp, ndisp_source=source)
+        res = {"middlebury": middlebury(est, gt, mask, ndisp=ndisp, round_disp=a.round_disp)}
     else:
-        mask = None if noc is None else np.isfinite(noc)
-        fn = middlebury if a.benchmark == "middlebury" else eth3d_two_view
-        res = {a.benchmark: fn(est, gt, mask)}
-    inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
-              "benchmark": a.benchmark}
+        mask = mask if noc is None else np.isfinite(noc)
+        res = {"eth3d": eth3d_two_view(est, gt, mask)}
 
     def figures():
         e = np.abs(est - gt)
@@ -68,6 +84,22 @@ def score_disparity(a):
     return inputs, res, figures
 
 
+def _middlebury_ndisp(a, gt, dataset_truth: bool):
+    """(ndisp, where it came from) for Middlebury's clipping of the estimates."""
+    if a.ndisp is not None:
+        return a.ndisp, "--ndisp"
+    if a.calib:
+        return middlebury_ndisp(a.calib), a.calib
+    if dataset_truth:  # what scenegen's Middlebury export writes into calib.txt for this truth
+        fin = gt[np.isfinite(gt)]
+        vmax = float(fin.max()) if fin.size else 0.0
+        return float(max(16, 16 * math.ceil(vmax / 16))), "dataset truth: max(16, 16 ceil(max d / 16)) as the export"
+    calib = Path(a.gt).parent / CALIB
+    if calib.is_file():
+        return middlebury_ndisp(calib), str(calib)
+    return None, f"none: no {CALIB} beside the truth, estimates not clipped (evaldisp clips to ndisp; pass --calib)"
+
+
 # --- depth ------------------------------------------------------------------------------------
 def depth_arguments(p) -> None:
     p.add_argument("est", help="predicted z-depth (.npy, .pfm, .exr), metres; with a dataset truth also a folder "
@@ -75,9 +107,16 @@ def depth_arguments(p) -> None:
     p.add_argument("gt", help="truth depth (.npy, .pfm, .exr), metres, or a dataset folder (truth/<view>.exr depth_z)")
     p.add_argument("--view", action="append", help="dataset truth: view(s) to score (default: all; a single "
                                                    "estimate file needs exactly one)")
-    p.add_argument("--alignment", choices=["none", "median", "scale_shift"], default="none")
-    p.add_argument("--min-depth", type=float, default=0.0)
-    p.add_argument("--max-depth", type=float, default=float("inf"))
+    p.add_argument("--alignment", choices=[a.value for a in DepthAlignment], default="none",
+                   help="scale_shift_inverse: least squares in inverse depth, as MiDaS / DPT")
+    p.add_argument("--min-depth", type=float, default=0.0, help="truth used where min < g < max (monodepth2: 1e-3)")
+    p.add_argument("--max-depth", type=float, default=float("inf"), help="(monodepth2 on KITTI: 80)")
+    p.add_argument("--no-clamp", action="store_true",
+                   help="do not clamp the aligned predictions to [min-depth, max-depth] (monodepth2 does)")
+    p.add_argument("--crop", choices=sorted(CROPS), help="evaluation crop: garg (monodepth2's) or eigen (BTS's)")
+    p.add_argument("--pred-inverse", action="store_true",
+                   help="the prediction is inverse depth up to scale and shift (MiDaS / DPT output); "
+                        "needs --alignment scale_shift_inverse")
 
 
 def _dataset_depths(a, ds):
@@ -115,15 +154,23 @@ def score_depth(a):
         est_list, gt_list, missing, gt_kind = [read_map(a.est, "depth")], [read_map(a.gt, "depth")], [], "file"
         same_shape(est_list[0], gt_list[0], a.est, a.gt)
     res = {"eigen": eigen_depth_metrics(est_list, gt_list, alignment=a.alignment,
-                                        min_depth_m=a.min_depth, max_depth_m=a.max_depth)}
+                                        min_depth_m=a.min_depth, max_depth_m=a.max_depth, clamp=not a.no_clamp,
+                                        crop=a.crop, pred_is_inverse=a.pred_inverse)}
     inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "views": names, "views_without_estimate": missing,
-              "alignment": a.alignment}
+              "alignment": a.alignment, "clamp": not a.no_clamp, "crop": a.crop, "pred_inverse": a.pred_inverse}
 
     def figures():
         r = res["eigen"]
         figs, rel = [], {}
         for k, (e, g) in enumerate(zip(est_list, gt_list)):
-            e_al = r.per_image_scale[k] * e + r.per_image_shift_m[k]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                if r.per_image_shift_inv_m is not None:  # aligned in inverse depth
+                    q = e if a.pred_inverse else 1.0 / e
+                    e_al = 1.0 / np.maximum(r.per_image_scale[k] * q + r.per_image_shift_inv_m[k], 1.0 / a.max_depth)
+                else:
+                    e_al = r.per_image_scale[k] * e + r.per_image_shift_m[k]
+                if r.clamp:
+                    e_al = np.clip(e_al, a.min_depth, a.max_depth)
             label = names[k] if names else Path(a.est).name
             if k < 8:
                 figs.append(Figure(f"Depth error: {label}",

@@ -3,24 +3,45 @@ readers registry sniffs (:func:`recon_eval.readers.registry.read_poses`; docs/me
 "Camera poses")."""
 from __future__ import annotations
 
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.align import Alignment
-from recon_eval.metrics.poses import Poses, ape, relative_pose, rpe
+from recon_eval.metrics.poses import DELTA_UNITS, POSE_ALIGNMENTS, Poses, ape, relative_pose, rpe
+from recon_eval.metrics.kitti_odometry import KITTI_LENGTHS_M, kitti_odometry
+from recon_eval.metrics.sfm import reconstruction_stats
+from recon_eval.readers.colmap_binary import read_colmap_binary
+from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.readers.registry import read_poses
 from recon_eval.readers.tum import associate
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
 
 def arguments(p) -> None:
     p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM or KITTI odometry trajectory, or a dataset")
     p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file")
-    p.add_argument("--alignment", choices=["none", "se3", "sim3"], default="sim3")
-    p.add_argument("--delta", type=int, default=1, help="RPE frame offset")
+    p.add_argument("--alignment", choices=list(POSE_ALIGNMENTS), default="sim3",
+                   help="evo's alignments: se3 = --align, sim3 = --align --correct_scale, scale = --correct_scale "
+                        "alone, origin = --align_origin (default sim3)")
+    p.add_argument("--align-origin", "--align_origin", dest="alignment", action="store_const", const="origin",
+                   help="evo --align_origin: same as --alignment origin")
+    p.add_argument("--n-to-align", "--n_to_align", type=int, default=-1,
+                   help="evo --n_to_align: fit the alignment on the first N registered cameras (default all)")
+    p.add_argument("--delta", type=float, default=1, help="RPE delta (evo --delta), in --delta-unit")
+    p.add_argument("--delta-unit", "--delta_unit", choices=list(DELTA_UNITS), default="f",
+                   help="evo --delta_unit: f frames, m metres of path, d degrees, r radians (default f)")
+    p.add_argument("--all-pairs", "--all_pairs", action="store_true",
+                   help="evo --all_pairs: RPE over (i, i + delta) for every i; default: consecutive pairs "
+                        "(0, d), (d, 2d), ... as plain evo_rpe")
+    p.add_argument("--rpe-gaps", choices=["bridge", "fail"], default="bridge",
+                   help="RPE across an unregistered camera: bridge = pair the registered poses as evo does "
+                        "(default; broken truth-frame pairs still counted as failures), fail = no bridging")
     p.add_argument("--max-time-diff", type=float, default=0.01, help="TUM timestamp association, seconds")
+    p.add_argument("--kitti-lengths", type=float, nargs="+", metavar="M",
+                   help="KITTI odometry segment lengths, metres (default the devkit's 100 200 ... 800)")
     p.add_argument("--camera", help="dataset truth: only the views of this spec camera (e.g. the left camera of a "
                                     "KITTI-style trajectory)")
     p.add_argument("--kitti-convention", choices=["world_from_cam", "cam_from_world"], default="world_from_cam",
@@ -40,6 +61,23 @@ def match_names_by_stem(est: Poses, gt: Poses) -> tuple[Poses, bool]:
                     break
         names.append(n)
     return (Poses(tuple(names), est.R_cam_from_world, est.t_cam_from_world) if renamed else est), renamed
+
+
+def colmap_model_stats(model_dir):
+    """COLMAP's mean reprojection error and track length of the model in ``model_dir``
+    (:func:`recon_eval.metrics.sfm.reconstruction_stats`), or None for a model without tracks."""
+    d = Path(model_dir)
+    model = read_colmap_binary(d) if (d / "images.bin").is_file() else read_colmap_text(d)
+    if len(model.track_point) == 0:
+        return None
+    try:
+        cams = {cid: Camera.from_colmap(c.model, c.width, c.height, c.params_colmap) for cid, c in model.cameras.items()}
+        per_image = [cams[cid] for cid in model.image_camera_ids]
+    except (KeyError, ValueError) as exc:
+        raise InputError(f"{d}: cameras: {exc}") from None
+    return reconstruction_stats(per_image, model.poses.R_cam_from_world, model.poses.t_cam_from_world,
+                                model.points_world, model.track_point, model.track_image,
+                                opencv_from_colmap_pixels(model.track_xy_colmap))
 
 
 def score(a):
@@ -63,11 +101,19 @@ def score(a):
             matching = "by name (folders and image extensions ignored where needed)"
     if len(gt.names) == 0:
         raise InputError(f"{a.gt}: the truth has no poses")
-    al = Alignment(a.alignment)
-    res = {"ape": ape(est, gt, alignment=al), "rpe": rpe(est, gt, delta_frames=a.delta, alignment=al),
-           "relative_pose": relative_pose(est, gt)}
+    al = a.alignment
+    delta = int(a.delta) if a.delta_unit == "f" and float(a.delta).is_integer() else a.delta
+    res = {"ape": ape(est, gt, alignment=al, n_to_align=a.n_to_align),
+           "rpe": rpe(est, gt, delta=delta, delta_unit=a.delta_unit, all_pairs=a.all_pairs, alignment=al,
+                      n_to_align=a.n_to_align, gaps=a.rpe_gaps),
+           "relative_pose": relative_pose(est, gt),
+           "kitti_odometry": kitti_odometry(est, gt, lengths_m=a.kitti_lengths or KITTI_LENGTHS_M)}
+    if ek == "colmap":
+        res["colmap_reconstruction"] = colmap_model_stats(a.est)
     inputs = {"est": a.est, "gt": a.gt, "format": ek, "gt_format": gk, "matching": matching,
-              "alignment": a.alignment, "delta_frames": a.delta, "camera": a.camera,
+              "alignment": a.alignment, "delta_frames": delta if a.delta_unit == "f" else None, "camera": a.camera,
+              "delta": delta, "delta_unit": a.delta_unit, "all_pairs": a.all_pairs, "n_to_align": a.n_to_align,
+              "rpe_gaps": a.rpe_gaps,
               "kitti_convention": a.kitti_convention if "kitti" in (ek, gk) else None}
 
     def figures():

@@ -6,20 +6,25 @@ mesh surface (point-to-triangle) or to a GT sample far denser than tau, and say 
 carry :class:`DistanceTo` so they say which.
 
 Point-to-triangle: closest point by Voronoi-region tests (Ericson, *Real-Time Collision
-Detection*, 2005, sec. 5.1.5), vectorised. Candidate triangles come from a KD-tree over triangle
-centroids with a bound that makes the search exact: if the triangle of the nearest centroid is at
-distance d0, every triangle T at distance <= d0 has its centroid within d0 + r_T (r_T: centroid to
-farthest vertex), so all such triangles are examined.
+Detection*, 2005, sec. 5.1.5), vectorised; the candidate triangles come from a bounding-volume
+hierarchy (:mod:`recon_eval.metrics.mesh_bvh`) that examines every triangle which could be the
+nearest, so the distance is exact, in memory bounded whatever the triangle sizes.
 """
 from __future__ import annotations
 
+import hashlib
 from enum import Enum
+from typing import Callable
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from recon_eval.arrays import as_float_array
 from recon_eval.errors import InputError
+from recon_eval.metrics.mesh_bvh import CHUNK, TriangleBVH, closest_points_on_triangles
+
+__all__ = ["DistanceTo", "MeshSurface", "closest_points_on_triangles", "mesh_surface_distances",
+           "nearest_point_distances", "sample_mesh_surface", "surface_distances"]
 
 
 class DistanceTo(str, Enum):
@@ -51,56 +56,14 @@ def nearest_point_distances(query, reference, *, workers: int = -1, upper_bound_
     return d
 
 
-def closest_points_on_triangles(p, a, b, c) -> np.ndarray:
-    """Closest point (K, 3) on triangle (a_k, b_k, c_k) to p_k; all inputs (K, 3).
-
-    Ericson (2005) sec. 5.1.5, ``ClosestPtPointTriangle``, with the region tests applied in the
-    book's order (earlier tests take priority). Degenerate (zero-area) triangles fall back to the
-    nearest of their three edges' end points and edges handled by the region tests; any NaN left
-    is replaced by the nearest vertex.
-    """
-    ab, ac, ap = b - a, c - a, p - a
-    bp, cp = p - b, p - c
-    d1 = np.einsum("ij,ij->i", ab, ap)
-    d2 = np.einsum("ij,ij->i", ac, ap)
-    d3 = np.einsum("ij,ij->i", ab, bp)
-    d4 = np.einsum("ij,ij->i", ac, bp)
-    d5 = np.einsum("ij,ij->i", ab, cp)
-    d6 = np.einsum("ij,ij->i", ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        denom = 1.0 / (va + vb + vc)
-        out = a + ab * (vb * denom)[:, None] + ac * (vc * denom)[:, None]  # face interior
-        # Later assignments override earlier ones: apply in reverse of Ericson's priority.
-        w_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-        m = (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)
-        out[m] = (b + (c - b) * w_bc[:, None])[m]
-        w_ac = d2 / (d2 - d6)
-        m = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
-        out[m] = (a + ac * w_ac[:, None])[m]
-        m = (d6 >= 0) & (d5 <= d6)
-        out[m] = c[m]
-        v_ab = d1 / (d1 - d3)
-        m = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
-        out[m] = (a + ab * v_ab[:, None])[m]
-        m = (d3 >= 0) & (d4 <= d3)
-        out[m] = b[m]
-        m = (d1 <= 0) & (d2 <= 0)
-        out[m] = a[m]
-    bad = ~np.all(np.isfinite(out), axis=1)
-    if np.any(bad):
-        verts = np.stack([a[bad], b[bad], c[bad]], axis=1)  # (k, 3, 3)
-        j = np.argmin(np.linalg.norm(verts - p[bad][:, None, :], axis=2), axis=1)
-        out[bad] = verts[np.arange(len(j)), j]
-    return out
-
-
-def mesh_surface_distances(query, vertices, faces, *, chunk: int = 20000) -> np.ndarray:
+def mesh_surface_distances(query, vertices, faces, *, chunk: int = CHUNK,
+                           progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """Exact Euclidean distance (N,) from each query point (N, 3) to the surface of a triangle
-    mesh with ``vertices`` (V, 3) metres and ``faces`` (F, 3) int vertex indices. Empty mesh ->
-    inf. Query points must be finite (non-finite ones get inf)."""
+    mesh with ``vertices`` (V, 3) metres and ``faces`` (F, 3) int vertex indices: the minimum over
+    all triangles of the float64 point-to-triangle distance, found through a
+    :class:`recon_eval.metrics.mesh_bvh.TriangleBVH` in memory bounded for any triangle sizes.
+    Empty mesh -> inf. Query points must be finite (non-finite ones get inf). ``progress(done,
+    total)`` is called after each batch of ``chunk`` points (the CLI prints it on stderr)."""
     q = as_float_array(query, "query points", (None, 3))
     V = as_float_array(vertices, "mesh vertices", (None, 3))
     Fc = np.asarray(faces)
@@ -112,31 +75,49 @@ def mesh_surface_distances(query, vertices, faces, *, chunk: int = 20000) -> np.
     out = np.full(len(q), np.inf)
     if len(q) == 0 or len(Fc) == 0:
         return out
-    tri = V[Fc]  # (F, 3, 3)
-    cen = tri.mean(axis=1)
-    r_tri = np.max(np.linalg.norm(tri - cen[:, None, :], axis=2), axis=1)  # (F,)
-    r_max = float(r_tri.max())
-    tree = cKDTree(cen)
-    k = min(8, len(Fc))
     finite = np.all(np.isfinite(q), axis=1)
-    idx_all = np.flatnonzero(finite)
-    for s in range(0, len(idx_all), chunk):
-        ids = idx_all[s : s + chunk]
-        p = q[ids]
-        # Exact distance to the k nearest-centroid triangles gives an upper bound d0; a point is
-        # settled when the k-th centroid is already beyond d0 + r_max (no farther triangle can be
-        # closer). Only unsettled points go through the (slower) ball query.
-        dk, jk = tree.query(p, k=k)
-        dk, jk = dk.reshape(len(p), k), jk.reshape(len(p), k)
-        pk = np.repeat(p, k, axis=0)
-        t = tri[jk.reshape(-1)]
-        dd = np.linalg.norm(pk - closest_points_on_triangles(pk, t[:, 0], t[:, 1], t[:, 2]), axis=1)
-        best = dd.reshape(len(p), k).min(axis=1)
-        open_ = (dk[:, -1] <= (best + r_max) * (1 + 1e-9) + 1e-12) & (k < len(Fc))
-        if np.any(open_):
-            best[open_] = _ball_search(p[open_], best[open_], tree, tri, cen, r_tri, r_max)
-        out[ids] = best
+    bvh = TriangleBVH(V[Fc])
+    out[finite] = np.sqrt(bvh.sq_distances(q[finite], chunk=chunk, progress=progress))
     return out
+
+
+class MeshSurface:
+    """A triangle mesh (vertices (V, 3) metres, faces (F, 3)) whose BVH is built once, for
+    scoring the same mesh against several metrics: :meth:`distances` is
+    :func:`mesh_surface_distances` and remembers its last answer (a second call with the same
+    points costs a hash). ``progress(done, total)``: see :func:`mesh_surface_distances`."""
+
+    def __init__(self, vertices, faces, *, progress: Callable[[int, int], None] | None = None):
+        self.vertices = as_float_array(vertices, "mesh vertices", (None, 3))
+        self.faces = np.asarray(faces)
+        mesh_surface_distances(np.zeros((0, 3)), self.vertices, self.faces)  # validates the faces
+        self.faces = self.faces.reshape(-1, 3).astype(np.int64)
+        self.progress = progress
+        self._bvh = TriangleBVH(self.vertices[self.faces]) if len(self.faces) else None
+        self._last: tuple | None = None
+
+    def __iter__(self):  # (vertices, faces), as the tuple form
+        return iter((self.vertices, self.faces))
+
+    def distances(self, query) -> np.ndarray:
+        q = as_float_array(query, "query points", (None, 3))
+        key = (q.shape, hashlib.blake2b(np.ascontiguousarray(q).tobytes(), digest_size=16).digest())
+        if self._last is not None and self._last[0] == key:
+            return self._last[1].copy()
+        out = np.full(len(q), np.inf)
+        finite = np.all(np.isfinite(q), axis=1)
+        if self._bvh is not None and len(q):
+            out[finite] = np.sqrt(self._bvh.sq_distances(q[finite], progress=self.progress))
+        self._last = (key, out.copy())
+        return out
+
+
+def surface_distances(query, gt_mesh) -> np.ndarray:
+    """Distances to ``gt_mesh``: a :class:`MeshSurface` or a (vertices, faces) pair."""
+    if isinstance(gt_mesh, MeshSurface):
+        return gt_mesh.distances(query)
+    vertices, faces = gt_mesh
+    return mesh_surface_distances(query, vertices, faces)
 
 
 def sample_mesh_surface(vertices, faces, n: int, *, seed: int) -> np.ndarray:
@@ -152,22 +133,3 @@ def sample_mesh_surface(vertices, faces, n: int, *, seed: int) -> np.ndarray:
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
     t = tri[k]
     return t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
-
-
-def _ball_search(p, d0, tree, tri, cen, r_tri, r_max) -> np.ndarray:
-    """Exact distances for points p (n, 3) given upper bounds d0 (n,): examine every triangle whose
-    centroid lies within d0 + r_T of the point."""
-    # 1e-9 relative slack so a candidate exactly on the bound is never lost to rounding.
-    radius = (d0 + r_max) * (1 + 1e-9) + 1e-12
-    lists = tree.query_ball_point(p, radius, return_sorted=False)
-    counts = np.fromiter((len(x) for x in lists), dtype=np.int64, count=len(lists))
-    cand = np.fromiter((j for x in lists for j in x), dtype=np.int64, count=int(counts.sum()))
-    owner = np.repeat(np.arange(len(p)), counts)
-    dc = np.linalg.norm(p[owner] - cen[cand], axis=1)
-    keep = dc <= (d0[owner] + r_tri[cand]) * (1 + 1e-9) + 1e-12
-    cand, owner = cand[keep], owner[keep]
-    cp = closest_points_on_triangles(p[owner], tri[cand, 0], tri[cand, 1], tri[cand, 2])
-    d = np.linalg.norm(p[owner] - cp, axis=1)
-    best = d0.copy()
-    np.minimum.at(best, owner, d)
-    return best

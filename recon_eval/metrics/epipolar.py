@@ -66,7 +66,8 @@ class FundamentalResult:
     """Scores of an estimated F on exact truth correspondences."""
 
     sampson_rms_px: float  # sqrt(mean Sampson error); inf if failed
-    sampson_median_px: float  # sqrt(median Sampson error)
+    sampson_median_px: float  # median of the per-point Sampson distances sqrt(s) (for even N the mean of the two
+    # middle distances, not sqrt of the mean of the two middle squared errors)
     sym_epipolar_rms_px: float  # sqrt(mean over the 2N point-to-line distances squared)
     n_points: int
     failed: bool
@@ -88,7 +89,7 @@ def fundamental_metrics(F_est, x1, x2) -> FundamentalResult:
         sym = symmetric_epipolar_sq_px2(F_est, x1, x2)
     s = np.where(np.isfinite(s), s, np.inf)  # a point on the epipole has no line: worst case
     sym = np.where(np.isfinite(sym), sym, np.inf)
-    return FundamentalResult(float(np.sqrt(np.mean(s))), float(np.sqrt(np.median(s))),
+    return FundamentalResult(float(np.sqrt(np.mean(s))), float(np.median(np.sqrt(s))),
                              float(np.sqrt(np.mean(sym) / 2.0)), len(x1), False, None)
 
 

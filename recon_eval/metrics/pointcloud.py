@@ -4,7 +4,8 @@ Definitions: shared/notes/metrics.md, "Point clouds and meshes" (reproduced in d
 All clouds are (N, 3) float64 in metres, already in the truth frame (align first with
 :mod:`recon_eval.metrics.align`; the result's ``alignment`` field is whatever the caller declares).
 
-Distances rec -> GT go to the GT mesh surface when ``gt_mesh=(vertices, faces)`` is given (exact
+Distances rec -> GT go to the GT mesh surface when ``gt_mesh=(vertices, faces)`` (or a
+:class:`recon_eval.metrics.distances.MeshSurface`, built once for several metrics) is given (exact
 point-to-triangle) and to the nearest GT point otherwise; distances GT -> rec always go to the
 nearest reconstructed point (a reconstruction is a cloud). ``distance_rec_to_gt`` says which.
 """
@@ -16,7 +17,7 @@ import numpy as np
 
 from recon_eval.arrays import as_float_array
 from recon_eval.errors import InputError
-from recon_eval.metrics.distances import DistanceTo, mesh_surface_distances, nearest_point_distances
+from recon_eval.metrics.distances import DistanceTo, nearest_point_distances, surface_distances
 
 
 def voxel_downsample(points, voxel_m: float) -> np.ndarray:
@@ -59,8 +60,7 @@ def _check_cloud(points, name: str) -> np.ndarray:
 
 def _rec_to_gt(rec: np.ndarray, gt: np.ndarray, gt_mesh) -> tuple[np.ndarray, DistanceTo]:
     if gt_mesh is not None:
-        vertices, faces = gt_mesh
-        return mesh_surface_distances(rec, vertices, faces), DistanceTo.MESH
+        return surface_distances(rec, gt_mesh), DistanceTo.MESH
     return nearest_point_distances(rec, gt), DistanceTo.POINTS
 
 
@@ -140,7 +140,7 @@ def tanks_and_temples_distances(points_rec, points_gt, tau_m: float, *, gt_mesh=
         to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
         return np.full(len(rec), np.inf), np.full(len(gt), np.inf), voxel, to.value
     if gt_mesh is not None:
-        d_rg, to = mesh_surface_distances(rec, *gt_mesh), DistanceTo.MESH
+        d_rg, to = surface_distances(rec, gt_mesh), DistanceTo.MESH
     else:
         d_rg, to = nearest_point_distances(rec, gt, upper_bound_m=upper_bound_m), DistanceTo.POINTS
     d_gr = nearest_point_distances(gt, rec, upper_bound_m=upper_bound_m)
@@ -212,6 +212,37 @@ def eth3d(
     return Eth3dResult(
         tolerance_m, acc, comp, _fscore(acc, comp), voxel_m, len(rec_s), int((~observed).sum()), len(gt), to.value
     )
+
+
+#: ETH3D's tolerance table (multi-view-evaluation: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m).
+ETH3D_TOLERANCES_M = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5)
+
+
+def eth3d_table(points_rec, points_gt, tolerances_m=ETH3D_TOLERANCES_M, *, gt_mesh=None, rec_observed=None,
+                voxel_m: float = 0.01) -> tuple[Eth3dResult, ...]:
+    """:func:`eth3d` at every tolerance (ETH3D evaluates its whole table at once), the distances
+    computed once. Identical to calling :func:`eth3d` per tolerance."""
+    rec = _check_cloud(points_rec, "reconstructed points")
+    gt = _check_cloud(points_gt, "GT points")
+    tols = tuple(float(t) for t in tolerances_m)
+    if not tols or not all(t > 0 for t in tols) or not voxel_m > 0:
+        raise InputError("tolerances and voxel size must be > 0 metres")
+    observed = np.ones(len(rec), bool) if rec_observed is None else np.asarray(rec_observed, bool).reshape(-1)
+    if observed.shape != (len(rec),):
+        raise InputError(f"rec_observed: expected shape ({len(rec)},), got {observed.shape}")
+    rec_s = rec[observed]
+    to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
+    n_un = int((~observed).sum())
+    if len(rec_s) == 0 or len(gt) == 0:
+        return tuple(Eth3dResult(t, 0.0, 0.0, 0.0, voxel_m, len(rec_s), n_un, len(gt), to.value) for t in tols)
+    d_rg, to = _rec_to_gt(rec_s, gt, gt_mesh)
+    d_gr = nearest_point_distances(gt, rec_s, upper_bound_m=max(tols) * (1.0 + _BOUND_SLACK))
+    out = []
+    for t in tols:
+        acc = _voxel_average(rec_s, d_rg <= t, voxel_m)
+        comp = _voxel_average(gt, d_gr <= t, voxel_m)
+        out.append(Eth3dResult(t, acc, comp, _fscore(acc, comp), voxel_m, len(rec_s), n_un, len(gt), to.value))
+    return tuple(out)
 
 
 # --- DTU ---------------------------------------------------------------------------------------

@@ -52,14 +52,17 @@ class Poses:
 
 
 @dataclass(frozen=True)
-class _Matched:
+class MatchedPoses:
+    """Estimated poses put in truth order (``match_poses``)."""
+
     R_est: np.ndarray  # (N, 3, 3), NaN for unregistered
     t_est: np.ndarray  # (N, 3), NaN for unregistered
     registered: np.ndarray  # (N,) bool
     n_extra: int  # estimated poses with no truth counterpart (ignored, reported)
 
 
-def _match(est: Poses, gt: Poses) -> _Matched:
+def match_poses(est: Poses, gt: Poses) -> MatchedPoses:
+    """The estimate of each truth camera, matched by name (a NaN pose is unregistered)."""
     index = {n: i for i, n in enumerate(est.names)}
     N = len(gt.names)
     R = np.full((N, 3, 3), np.nan)
@@ -72,24 +75,60 @@ def _match(est: Poses, gt: Poses) -> _Matched:
         Ri, ti = est.R_cam_from_world[i], est.t_cam_from_world[i]
         if np.all(np.isfinite(Ri)) and np.all(np.isfinite(ti)):  # a NaN pose is unregistered
             R[k], t[k], reg[k] = Ri, ti, True
-    return _Matched(R, t, reg, len(set(est.names) - set(gt.names)))
+    return MatchedPoses(R, t, reg, len(set(est.names) - set(gt.names)))
 
 
 def registration_ratio(est: Poses, gt: Poses) -> float:
     """Fraction of truth cameras with a finite estimated pose of the same name, in [0, 1]."""
-    return float(np.mean(_match(est, gt).registered)) if len(gt.names) else 0.0
+    return float(np.mean(match_poses(est, gt).registered)) if len(gt.names) else 0.0
 
 
-def _alignment_transform(m: _Matched, gt: Poses, alignment: Alignment) -> Sim3:
-    if alignment == Alignment.NONE:
+#: Pose alignments, as evo names them: ``none``; ``se3`` (``--align``), ``sim3`` (``--align
+#: --correct_scale``), ``scale`` (``--correct_scale`` alone: the Sim(3) scale applied to the
+#: estimated positions about the origin, orientations unchanged), all Umeyama on camera centres;
+#: ``origin`` (``--align_origin``: the estimate's first pose moved onto the truth's first pose).
+POSE_ALIGNMENTS = ("none", "se3", "sim3", "scale", "origin")
+
+
+def _alignment_name(alignment) -> str:
+    name = alignment.value if isinstance(alignment, Alignment) else str(alignment)
+    if name not in POSE_ALIGNMENTS:
+        raise InputError(f"pose alignment must be one of {', '.join(POSE_ALIGNMENTS)}, got {name}")
+    return name
+
+
+def pose_alignment(m: MatchedPoses, gt: Poses, alignment, n_to_align: int = -1) -> Sim3:
+    """``truth_from_estimate`` for the declared alignment (:data:`POSE_ALIGNMENTS`), over the
+    registered cameras in truth order: Umeyama on their centres (the first ``n_to_align`` of them
+    when > 0, evo's ``--n_to_align``; evo ``PosePath3D.align``), or the origin alignment
+    ``Q_0 P_0^-1`` of the first registered camera (evo ``align_origin``; world_from_cam poses)."""
+    name = _alignment_name(alignment)
+    if name == "none":
         return Sim3()
-    if alignment not in (Alignment.SE3, Alignment.SIM3):
-        raise InputError(f"pose alignment must be none, se3 or sim3, got {alignment.value}")
-    c_est = -np.einsum("nji,nj->ni", m.R_est[m.registered], m.t_est[m.registered])
-    c_gt = gt.centers_world[m.registered]
+    reg = np.flatnonzero(m.registered)
+    if name == "origin":
+        if len(reg) == 0:
+            raise InputError("origin alignment needs a registered camera")
+        k = reg[0]
+        Rq, Rp = gt.R_cam_from_world[k].T, m.R_est[k].T  # world_from_cam rotations
+        cq, cp = gt.centers_world[k], -Rp @ m.t_est[k]
+        R = Rq @ Rp.T
+        return Sim3(R, cq - R @ cp, 1.0)
+    if n_to_align is not None and n_to_align > 0:
+        reg = reg[:n_to_align]
+    c_est = -np.einsum("nji,nj->ni", m.R_est[reg], m.t_est[reg])
+    c_gt = gt.centers_world[reg]
     if len(c_est) < 3:
-        raise InputError(f"{alignment.value} alignment needs >= 3 registered cameras, got {len(c_est)}")
-    return umeyama(c_est, c_gt, with_scale=alignment == Alignment.SIM3)
+        raise InputError(f"{name} alignment needs >= 3 registered cameras, got {len(c_est)}")
+    T = umeyama(c_est, c_gt, with_scale=name in ("sim3", "scale"))
+    return Sim3(np.eye(3), np.zeros(3), T.scale) if name == "scale" else T
+
+
+def _aligned(m: MatchedPoses, T: Sim3) -> tuple[np.ndarray, np.ndarray]:
+    R, t = m.R_est.copy(), m.t_est.copy()
+    if np.any(m.registered):
+        R[m.registered], t[m.registered] = T.cam_from_tgt(m.R_est[m.registered], m.t_est[m.registered])
+    return R, t
 
 
 @dataclass(frozen=True)
@@ -105,17 +144,19 @@ class ApeResult:
     n_registered: int
     n_gt: int
     n_extra: int  # estimated poses whose name is not in the truth (ignored)
-    alignment: str  # Alignment value
+    alignment: str  # one of POSE_ALIGNMENTS
     tgt_from_src: Sim3  # the alignment applied (truth_from_estimate)
+    n_to_align: int = -1  # cameras the alignment was fitted on (first n registered; -1 = all, evo)
 
 
-def ape(est: Poses, gt: Poses, *, alignment: Alignment = Alignment.SIM3) -> ApeResult:
-    """evo APE with the declared alignment (Umeyama SE(3)/Sim(3) on registered camera centres):
-    translation error |t_est - t_ref| of camera positions, rotation error |Log(P_est^-1 P_ref)|
-    (its angle). Inputs are not modified."""
-    alignment = Alignment(alignment)
-    m = _match(est, gt)
-    T = _alignment_transform(m, gt, alignment)
+def ape(est: Poses, gt: Poses, *, alignment=Alignment.SIM3, n_to_align: int = -1) -> ApeResult:
+    """evo APE with the declared alignment (:func:`pose_alignment`): translation error
+    |t_est - t_ref| of camera positions, rotation error |Log(P_est^-1 P_ref)| (its angle).
+    Unregistered cameras are inf (evo drops them; its numbers are the statistics here, whose
+    ``n_failed`` counts them). Inputs are not modified."""
+    name = _alignment_name(alignment)
+    m = match_poses(est, gt)
+    T = pose_alignment(m, gt, name, n_to_align)
     N = len(gt.names)
     terr = np.full(N, np.inf)
     rerr = np.full(N, np.inf)
@@ -127,60 +168,156 @@ def ape(est: Poses, gt: Poses, *, alignment: Alignment = Alignment.SIM3) -> ApeR
         rerr[reg] = np.degrees(rotation_error_rad(R_al, gt.R_cam_from_world[reg]))
     return ApeResult(
         gt.names, frozen(terr), frozen(rerr), error_stats(terr), error_stats(rerr),
-        float(np.mean(reg)) if N else 0.0, int(reg.sum()), N, m.n_extra, alignment.value, T,
+        float(np.mean(reg)) if N else 0.0, int(reg.sum()), N, m.n_extra, name, T, n_to_align,
     )
+
+
+#: evo's ``--delta_unit``: frames, metres of path, degrees or radians of rotation.
+DELTA_UNITS = ("f", "m", "d", "r")
+
+
+def delta_pairs(R_world_from_cam, centers, delta, unit: str = "f", *, all_pairs: bool = False,
+                rel_tol: float = 0.1) -> list[tuple[int, int]]:
+    """Index pairs of a pose sequence as evo forms them (evo 1.38 ``core/filters.py``
+    ``filter_pairs_by_index`` / ``_by_path`` / ``_by_angle`` via ``metrics.id_pairs_from_delta``).
+
+    ``f``: (0, d), (d, 2d), ... or, ``all_pairs``, (i, i + d) for every i. ``m``: consecutive pairs
+    close when the travelled path reaches ``delta`` (then restarts), all pairs: for each i the j
+    whose path from i is nearest to ``delta`` if within ``rel_tol * delta``. ``d``/``r``: the same
+    with the accumulated rotation angle of consecutive poses; all pairs: every (i, j > i) whose
+    direct relative angle is within ``delta +- rel_tol * delta``."""
+    n = len(centers)
+    if unit not in DELTA_UNITS:
+        raise InputError(f"delta unit must be one of {', '.join(DELTA_UNITS)}, got {unit!r}")
+    if unit == "f":
+        d = int(delta)
+        if d != delta or d < 1:
+            raise InputError(f"delta in frames must be an integer >= 1, got {delta}")
+        if all_pairs:
+            return [(i, i + d) for i in range(n - d)]
+        ids = list(range(0, n, d))
+        return list(zip(ids, ids[1:]))
+    if not delta > 0:
+        raise InputError(f"delta must be > 0, got {delta}")
+    tol = delta * rel_tol
+    if unit == "m":
+        step = np.linalg.norm(np.diff(centers, axis=0), axis=1)
+        if all_pairs:
+            dist = np.r_[0.0, np.cumsum(step)]
+            out = []
+            for i in range(n - 1):
+                here = dist[i + 1:] - dist[i]
+                k = int(np.argmin(np.abs(here - delta)))
+                if abs(here[k] - delta) <= tol:
+                    out.append((i, i + 1 + k))
+            return out
+        ids, path = [0], 0.0
+        for i in range(1, n):
+            path += float(step[i - 1])
+            if path >= delta:
+                ids.append(i)
+                path = 0.0
+        return list(zip(ids, ids[1:]))
+    bound = 180.0 if unit == "d" else np.pi
+    if delta > bound:
+        raise InputError(f"delta angle must be within [0, {bound}], got {delta}")
+    scale = np.pi / 180.0 if unit == "d" else 1.0
+    delta, tol = delta * scale, tol * scale
+    R = np.asarray(R_world_from_cam, float)
+    if all_pairs:
+        out = []
+        for i in range(n - 1):
+            ang = np.atleast_1d(rotation_error_rad(np.broadcast_to(R[i], R[i + 1:].shape), R[i + 1:]))
+            out.extend((i, int(j)) for j in np.flatnonzero((delta - tol <= ang) & (ang <= delta + tol)) + i + 1)
+        return out
+    step = np.atleast_1d(rotation_error_rad(R[:-1], R[1:])) if n > 1 else np.zeros(0)
+    out, acc, start = [], 0.0, 0
+    for i, a in enumerate(step):
+        acc += float(a)
+        if acc >= delta:
+            out.append((start, i + 1))
+            acc, start = 0.0, i + 1
+    return out
 
 
 @dataclass(frozen=True)
 class RpeResult:
-    """Relative pose error (evo ``evo_rpe``) over frame pairs (i, i + delta) in truth order."""
+    """Relative pose error (evo ``evo_rpe``).
+
+    The pairs are evo's, formed over the registered poses in truth order (a gap is bridged, as
+    evo pairs the poses that survive its association), followed in truth order by the pairs of
+    truth frames that an unregistered camera breaks (inf: failures). So the statistics' finite
+    part is evo's number and their ``n_failed`` the failure count. ``gaps='fail'`` forms the pairs
+    over the truth frames only (no bridging)."""
 
     pairs: tuple  # ((name_i, name_j), ...)
-    trans_err_m: np.ndarray  # (P,) |translation of (Q_i^-1 Q_j)^-1 (P_i^-1 P_j)|, inf if either unregistered
+    trans_err_m: np.ndarray  # (P,) |translation of (Q_i^-1 Q_j)^-1 (P_i^-1 P_j)|, inf for a broken pair
     rot_err_deg: np.ndarray  # (P,) its rotation angle
     trans_stats_m: ErrorStats
     rot_stats_deg: ErrorStats
-    delta_frames: int
+    delta_frames: int | None  # delta when delta_unit is 'f', else None
     alignment: str
     tgt_from_src: Sim3
+    delta: float = 1.0
+    delta_unit: str = "f"  # evo --delta_unit: f frames, m metres, d degrees, r radians
+    all_pairs: bool = False  # evo --all_pairs; default: consecutive pairs (0, d), (d, 2d), ...
+    gaps: str = "bridge"  # 'bridge' (evo) or 'fail'
+    n_failed_pairs: int = 0  # truth-frame pairs with an unregistered camera
+    registration_ratio: float = 1.0
+    n_to_align: int = -1
+    pairs_from: str = "estimate"  # the poses a non-frame delta is measured on (evo's default)
 
 
-def rpe(est: Poses, gt: Poses, *, delta_frames: int = 1, alignment: Alignment = Alignment.SIM3) -> RpeResult:
-    """evo RPE: for pairs (i, i + delta) of truth frames, with world_from_cam poses P (estimate,
-    aligned) and Q (truth), the error E_ij = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j); translation error |t(E)|
-    metres, rotation error angle(R(E)). SE(3) alignment does not change RPE; Sim(3) fixes the
-    scale. A pair with an unregistered camera is a failure (inf)."""
-    alignment = Alignment(alignment)
-    if delta_frames < 1:
-        raise InputError(f"delta_frames must be >= 1, got {delta_frames}")
-    m = _match(est, gt)
-    T = _alignment_transform(m, gt, alignment)
+def rpe(est: Poses, gt: Poses, *, delta_frames: int | None = None, delta: float = 1.0, delta_unit: str = "f",
+        all_pairs: bool = False, alignment=Alignment.SIM3, n_to_align: int = -1, gaps: str = "bridge",
+        pairs_from_reference: bool = False, rel_delta_tol: float = 0.1) -> RpeResult:
+    """evo RPE (``evo_rpe``, evo 1.38 ``core/metrics.py`` ``RPE``): for pose pairs (i, j) with
+    world_from_cam poses P (estimate, aligned) and Q (truth), E_ij = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j);
+    translation error |t(E)| metres, rotation error angle(R(E)) degrees. Pairs by
+    :func:`delta_pairs` (``delta``, ``delta_unit``, ``all_pairs``; ``delta_frames`` is the
+    frames delta, kept for callers), measured on the aligned estimate unless
+    ``pairs_from_reference``. See :class:`RpeResult` for unregistered cameras."""
+    name = _alignment_name(alignment)
+    if delta_frames is not None:
+        delta, delta_unit = delta_frames, "f"
+    if gaps not in ("bridge", "fail"):
+        raise InputError(f"gaps must be 'bridge' or 'fail', got {gaps!r}")
+    m = match_poses(est, gt)
+    T = pose_alignment(m, gt, name, n_to_align)
     N = len(gt.names)
-    R_e, t_e = m.R_est.copy(), m.t_est.copy()
-    if np.any(m.registered):
-        R_e[m.registered], t_e[m.registered] = T.cam_from_tgt(m.R_est[m.registered], m.t_est[m.registered])
-    i = np.arange(0, max(N - delta_frames, 0))
-    j = i + delta_frames
+    R_e, t_e = _aligned(m, T)
+    Rw_e = np.swapaxes(R_e, 1, 2)
+    c_e = -np.einsum("nji,nj->ni", R_e, t_e)
+    Rw_g, c_g = np.swapaxes(gt.R_cam_from_world, 1, 2), gt.centers_world
 
-    def rel(R, t):  # cam_j_from_cam_i ... as world_from_cam: P_i^-1 P_j = cam_i_from_cam_j
-        Rw, cw = np.swapaxes(R, 1, 2), -np.einsum("nji,nj->ni", R, t)  # world_from_cam
-        R_ij = np.swapaxes(Rw[i], 1, 2) @ Rw[j]
-        t_ij = np.einsum("nji,nj->ni", Rw[i], cw[j] - cw[i])
-        return R_ij, t_ij
+    def pairs_over(idx):  # pairs (truth indices) over the poses idx, measured as evo does
+        Rw, c = (Rw_g[idx], c_g[idx]) if pairs_from_reference or not np.all(m.registered[idx]) else (Rw_e[idx], c_e[idx])
+        return [(int(idx[a]), int(idx[b])) for a, b in delta_pairs(Rw, c, delta, delta_unit, all_pairs=all_pairs,
+                                                                     rel_tol=rel_delta_tol)]
 
-    Rq, tq = rel(gt.R_cam_from_world, gt.t_cam_from_world)
-    Rp, tp = rel(R_e, t_e)
-    # E = Q_ij^-1 P_ij: R_E = Rq^T Rp, t_E = Rq^T (tp - tq)
-    RE = np.swapaxes(Rq, 1, 2) @ Rp
-    tE = np.einsum("nji,nj->ni", Rq, tp - tq)
-    ok = m.registered[i] & m.registered[j]
-    terr = np.where(ok, np.linalg.norm(np.where(ok[:, None], tE, 0.0), axis=1), np.inf)
-    rerr = np.full(len(i), np.inf)
+    reg = np.flatnonzero(m.registered)
+    truth_pairs = pairs_over(np.arange(N))
+    broken = [(i, j) for i, j in truth_pairs if not (m.registered[i] and m.registered[j])]
+    scored = pairs_over(reg) if gaps == "bridge" else [p for p in truth_pairs if p not in set(broken)]
+    ij = sorted(set(scored) | set(broken))
+    i = np.array([a for a, _ in ij], dtype=np.int64)
+    j = np.array([b for _, b in ij], dtype=np.int64)
+    ok = m.registered[i] & m.registered[j] if len(ij) else np.zeros(0, bool)
+    terr = np.full(len(ij), np.inf)
+    rerr = np.full(len(ij), np.inf)
     if np.any(ok):
-        rerr[ok] = np.degrees(rotation_error_rad(np.eye(3), RE[ok]))
-    pairs = tuple((gt.names[a], gt.names[b]) for a, b in zip(i, j))
-    return RpeResult(pairs, frozen(terr), frozen(rerr), error_stats(terr), error_stats(rerr), delta_frames,
-                     alignment.value, T)
+        a, b = i[ok], j[ok]
+        Rq = np.swapaxes(Rw_g[a], 1, 2) @ Rw_g[b]  # Q_i^-1 Q_j
+        tq = np.einsum("nji,nj->ni", Rw_g[a], c_g[b] - c_g[a])
+        Rp = np.swapaxes(Rw_e[a], 1, 2) @ Rw_e[b]
+        tp = np.einsum("nji,nj->ni", Rw_e[a], c_e[b] - c_e[a])
+        terr[ok] = np.linalg.norm(np.einsum("nji,nj->ni", Rq, tp - tq), axis=1)  # t(Q_ij^-1 P_ij)
+        rerr[ok] = np.degrees(rotation_error_rad(Rq, Rp))
+    pairs = tuple((gt.names[a], gt.names[b]) for a, b in ij)
+    return RpeResult(pairs, frozen(terr), frozen(rerr), error_stats(terr), error_stats(rerr),
+                     int(delta) if delta_unit == "f" else None, name, T, float(delta), delta_unit, bool(all_pairs),
+                     gaps, len(broken), float(np.mean(m.registered)) if N else 0.0, n_to_align,
+                     "reference" if pairs_from_reference else "estimate")
 
 
 # --- relative pose between image pairs -------------------------------------------------------
@@ -209,14 +346,18 @@ def relative_pose_errors_deg(R_est, t_est, R_gt, t_gt) -> tuple[np.ndarray, np.n
 
 
 def maa_deg(pose_err_deg, max_threshold_deg: int = 10) -> float:
-    """Image Matching Benchmark mean average accuracy: mean over thresholds 1, 2, ..., max deg of
-    the fraction of pairs with pose error (max(err_q, err_t)) strictly below the threshold.
+    """Image Matching Benchmark mean average accuracy (ubc-vision/image-matching-benchmark,
+    utils/pack_helper.py ``compute_qt_auc``): ``np.histogram`` of the pose errors (max(err_q, err_t),
+    degrees) over the bins ``np.arange(max + 1)``, cumulated and averaged over the ``max`` thresholds.
+    numpy closes the last bin, so at thresholds 1 .. max-1 a pair counts when ``err < th`` and at
+    the last threshold when ``err <= max``. Failures (inf, NaN) are misses (IMB maps inf to 1e6).
     Discrete: not the same number as the AUC. Empty -> 0."""
     e = np.asarray(pose_err_deg, float).reshape(-1)
     if len(e) == 0:
         return 0.0
-    ths = np.arange(1, max_threshold_deg + 1, dtype=float)
-    return float(np.mean([np.mean(e < th) for th in ths]))
+    e = np.where(np.isfinite(e), e, 1e6)
+    hist, _ = np.histogram(e, np.arange(max_threshold_deg + 1))
+    return float(np.mean(np.cumsum(hist.astype(float) / len(e))))
 
 
 @dataclass(frozen=True)
@@ -240,7 +381,7 @@ def relative_pose(est: Poses, gt: Poses, pairs: Sequence[tuple[str, str]] | None
     truth image names (default: all unordered pairs in truth order). No alignment is needed (the
     relative pose is gauge-free up to scale, and only directions are compared). A pair with an
     unregistered camera is a failure (inf)."""
-    m = _match(est, gt)
+    m = match_poses(est, gt)
     idx = {n: k for k, n in enumerate(gt.names)}
     if pairs is None:
         pairs = list(combinations(gt.names, 2))

@@ -30,7 +30,9 @@ def kitti_interpolate_background(disp) -> np.ndarray:
     Per row, an interior gap (valid neighbours on both sides) takes the smaller (background) of its
     two neighbours; leading/trailing gaps copy the nearest valid value of the row. Then per column,
     still-invalid pixels at the top/bottom copy the nearest valid value of the column. An image
-    with no valid pixel stays all NaN. Returns a new (H, W) array.
+    with no valid pixel stays all NaN; so do wholly invalid interior rows (the column pass only
+    extrapolates to the top and bottom): the devkit leaves them at -1 and :func:`kitti_d1` scores
+    them as -1 too. Returns a new (H, W) array.
     """
     d = np.array(disp, dtype=np.float64, copy=True)
     H, W = d.shape
@@ -78,6 +80,14 @@ class KittiD1Result:
     operator: str = "err > abs AND err/|gt| > rel"
     aggregation: str = "pooled over images"
     interpolation: str = "kitti_background"
+    # the devkit's "est" rows: the same outliers over the pixels with a valid estimate (before
+    # interpolation) only; NaN where there is none
+    d1_bg_noc_est_pct: float = float("nan")
+    d1_fg_noc_est_pct: float = float("nan")
+    d1_all_noc_est_pct: float = float("nan")
+    d1_bg_occ_est_pct: float = float("nan")
+    d1_fg_occ_est_pct: float = float("nan")
+    d1_all_occ_est_pct: float = float("nan")
 
 
 def kitti_d1(
@@ -90,9 +100,13 @@ def kitti_d1(
     rel_thresh: float = 0.05,
 ) -> KittiD1Result:
     """KITTI 2015 D1 (Menze & Geiger, CVPR 2015; devkit ``disp_err`` in io_disp.h): a pixel is an
-    outlier if ``|d - d*| > 3 px AND |d - d*| / |d*| > 5 %``. Missing estimates are filled by
-    :func:`kitti_interpolate_background` and still scored; density is reported. Errors are pooled:
-    sum of outliers over all images / sum of valid truth pixels. Percent; NaN where no pixel.
+    outlier if ``|d - d*| > 3 px AND |d - d*| / |d*| > 5 %``. Missing estimates (NaN or negative:
+    the devkit's ``isValid`` is ``d >= 0``) are filled by :func:`kitti_interpolate_background` and
+    still scored; pixels nothing fills (an image or an interior row without any estimate) keep the
+    devkit's invalid value -1 and are scored with it. Density is reported, and the devkit's "est"
+    rows (the pixels with an estimate before interpolation). Errors are pooled: sum of outliers
+    over all images / sum of valid truth pixels (devkit ``disparityErrorsOutlier``,
+    evaluate_stereo.cpp). Percent; NaN where no pixel.
 
     disp_est, disp_gt_occ: sequences of (H, W) arrays (pixels, NaN = invalid); disp_gt_noc: the
     non-occluded truth (default: the occ truth); obj_map: foreground masks (> 0 = foreground,
@@ -101,7 +115,8 @@ def kitti_d1(
     n = len(disp_est)
     if n == 0 or len(disp_gt_occ) != n:
         raise InputError(f"kitti_d1: need as many truth maps as estimates (>0), got {n} and {len(disp_gt_occ)}")
-    bad = {k: 0 for k in ("bg_noc", "fg_noc", "bg_occ", "fg_occ")}
+    regions = [f"{r}_{w}{e}" for r in ("bg", "fg") for w in ("noc", "occ") for e in ("", "_est")]
+    bad = {k: 0 for k in regions}
     tot = dict(bad)
     n_valid_est = n_gt_px = 0
     for k in range(n):
@@ -110,31 +125,37 @@ def kitti_d1(
         fg = np.zeros(e.shape, bool) if obj_map is None else np.asarray(obj_map[k]) > 0
         if fg.shape != e.shape:
             raise InputError(f"obj_map #{k}: expected shape {e.shape}, got {fg.shape}")
+        with np.errstate(invalid="ignore"):
+            est_valid = np.isfinite(e) & (e >= 0)
+        e = np.where(est_valid, e, np.nan)
         valid_occ = np.isfinite(g_occ) & (g_occ > 0)
         n_gt_px += int(valid_occ.sum())
-        n_valid_est += int((valid_occ & np.isfinite(e)).sum())
+        n_valid_est += int((valid_occ & est_valid).sum())
         ei = kitti_interpolate_background(e)
+        ei[~np.isfinite(ei)] = -1.0  # the devkit's invalid value, left where nothing interpolates
         for name, g in (("noc", g_noc), ("occ", g_occ)):
             valid = np.isfinite(g) & (g > 0)
             with np.errstate(invalid="ignore", divide="ignore"):
                 err = np.abs(ei - g)
                 out = (err > abs_thresh_px) & (err / np.abs(g) > rel_thresh)
-            out |= ~np.isfinite(ei)  # nothing to interpolate from: every pixel is an outlier
             for region, mask in (("bg", ~fg), ("fg", fg)):
-                sel = valid & mask
-                bad[f"{region}_{name}"] += int((out & sel).sum())
-                tot[f"{region}_{name}"] += int(sel.sum())
+                for suffix, sel in (("", valid & mask), ("_est", valid & mask & est_valid)):
+                    bad[f"{region}_{name}{suffix}"] += int((out & sel).sum())
+                    tot[f"{region}_{name}{suffix}"] += int(sel.sum())
 
     def pct(b, t):
         return 100.0 * b / t if t else float("nan")
 
+    def d1(name):  # (bg, fg, all) of one row
+        b, f = f"bg_{name}", f"fg_{name}"
+        return pct(bad[b], tot[b]), pct(bad[f], tot[f]), pct(bad[b] + bad[f], tot[b] + tot[f])
+
+    noc, occ, noc_est, occ_est = d1("noc"), d1("occ"), d1("noc_est"), d1("occ_est")
     return KittiD1Result(
-        pct(bad["bg_noc"], tot["bg_noc"]), pct(bad["fg_noc"], tot["fg_noc"]),
-        pct(bad["bg_noc"] + bad["fg_noc"], tot["bg_noc"] + tot["fg_noc"]),
-        pct(bad["bg_occ"], tot["bg_occ"]), pct(bad["fg_occ"], tot["fg_occ"]),
-        pct(bad["bg_occ"] + bad["fg_occ"], tot["bg_occ"] + tot["fg_occ"]),
-        pct(n_valid_est, n_gt_px), tot["bg_noc"] + tot["fg_noc"], tot["bg_occ"] + tot["fg_occ"], n,
-        abs_thresh_px, rel_thresh,
+        *noc, *occ, pct(n_valid_est, n_gt_px), tot["bg_noc"] + tot["fg_noc"], tot["bg_occ"] + tot["fg_occ"], n,
+        abs_thresh_px, rel_thresh, d1_bg_noc_est_pct=noc_est[0], d1_fg_noc_est_pct=noc_est[1],
+        d1_all_noc_est_pct=noc_est[2], d1_bg_occ_est_pct=occ_est[0], d1_fg_occ_est_pct=occ_est[1],
+        d1_all_occ_est_pct=occ_est[2],
     )
 
 
@@ -159,12 +180,17 @@ class TwoViewResult:
     benchmark: str  # 'middlebury_v3' or 'eth3d_two_view'
     denominator: str  # 'truth pixels' (Middlebury) or 'covered pixels' (ETH3D)
     operator: str = ">"  # bad when err > threshold
+    ndisp: float | None = None  # Middlebury: estimates clipped to [0, ndisp] (calib.txt); None = not clipped
+    round_disp: bool = False  # Middlebury evaldisp's rounddisp: estimates rounded to integers
 
 
-def two_view_metrics(est_list, gt_list, masks, *, benchmark: str) -> TwoViewResult:
+def two_view_metrics(est_list, gt_list, masks, *, benchmark: str, ndisp: float | None = None,
+                     round_disp: bool = False) -> TwoViewResult:
     """Middlebury v3 (``benchmark="middlebury_v3"``) or ETH3D (``"eth3d_two_view"``) metrics of
     (H, W) estimates and truths (pixels), pooled over the pairs (the benchmarks count per pixel);
     ``masks``: per-pair (H, W) bool restrictions, or None. See :func:`middlebury`."""
+    if (ndisp is not None or round_disp) and benchmark != "middlebury_v3":
+        raise InputError("ndisp and round_disp are Middlebury evaldisp options")
     errs, n_gt, n_cov = [], 0, 0
     for k, (e_in, g_in) in enumerate(zip(est_list, gt_list)):
         e, g = _pair(e_in, g_in, k)
@@ -175,6 +201,10 @@ def two_view_metrics(est_list, gt_list, masks, *, benchmark: str) -> TwoViewResu
                 raise InputError(f"mask #{k}: expected shape {g.shape}, got {m.shape}")
             valid_gt &= m
         valid_est = np.isfinite(e)
+        if ndisp is not None:  # evaldisp: d = max(0, min(maxd, d)) for valid estimates
+            e = np.where(valid_est, np.clip(e, 0.0, ndisp), e)
+        if round_disp:
+            e = np.where(valid_est, np.round(e), e)
         if benchmark == "eth3d_two_view":  # ETH3D: |d| > image width is treated as missing
             valid_est &= np.abs(np.where(valid_est, e, 0.0)) <= g.shape[1]
         cov = valid_gt & valid_est
@@ -197,16 +227,21 @@ def two_view_metrics(est_list, gt_list, masks, *, benchmark: str) -> TwoViewResu
         q, avg, rms = [float("nan")] * 4, float("nan"), float("nan")
     totbad = pct(int(np.sum(err > 2.0)) + (n_gt - n_cov), n_gt)
     return TwoViewResult(*bad, invalid, totbad, avg, rms, *q, pct(n_cov, n_gt), n_gt, benchmark,
-                         "truth pixels" if benchmark == "middlebury_v3" else "covered pixels")
+                         "truth pixels" if benchmark == "middlebury_v3" else "covered pixels",
+                         ndisp=None if ndisp is None else float(ndisp), round_disp=bool(round_disp))
 
 
-def middlebury(disp_est, disp_gt, nonocc_mask=None) -> TwoViewResult:
-    """Middlebury v3 (Scharstein et al., GCPR 2014; MiddEval3 ``evaldisp``): truth = inf is
-    unknown and skipped; bad-x = % of truth pixels whose valid estimate has err > x; invalid = % of
-    truth pixels with no valid (finite) estimate; totbad = bad + invalid; avgerr, rms and the
-    quantiles over valid estimates. ``nonocc_mask`` (H, W) bool restricts to non-occluded pixels.
-    One pair of (H, W) arrays, pixels."""
-    return two_view_metrics([disp_est], [disp_gt], None if nonocc_mask is None else [nonocc_mask], benchmark="middlebury_v3")
+def middlebury(disp_est, disp_gt, nonocc_mask=None, *, ndisp: float | None = None,
+               round_disp: bool = False) -> TwoViewResult:
+    """Middlebury v3 (Scharstein et al., GCPR 2014; MiddEval3 ``evaldisp.cpp``): truth = inf is
+    unknown and skipped; valid (finite) estimates are clipped to [0, ndisp] (``d = max(0, min(maxd,
+    d))``, ndisp from the dataset's calib.txt; None = no clipping) and rounded if ``round_disp``;
+    bad-x = % of truth pixels whose valid estimate has err > x; invalid = % of truth pixels with no
+    valid estimate; totbad = bad + invalid; avgerr (``serr / (n - invalid)``), rms and the
+    quantiles over valid estimates. ``nonocc_mask`` (H, W) bool restricts to non-occluded pixels
+    (evaldisp evaluates where mask0nocc.png is 255). One pair of (H, W) arrays, pixels."""
+    return two_view_metrics([disp_est], [disp_gt], None if nonocc_mask is None else [nonocc_mask],
+                            benchmark="middlebury_v3", ndisp=ndisp, round_disp=round_disp)
 
 
 def eth3d_two_view(disp_est, disp_gt, mask=None) -> TwoViewResult:

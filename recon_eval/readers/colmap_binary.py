@@ -10,7 +10,7 @@ import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.metrics.poses import Poses
-from recon_eval.readers.colmap_text import ColmapModel, make_camera, rotations_from_quats
+from recon_eval.readers.colmap_text import ColmapModel, build_tracks, make_camera, rotations_from_quats
 
 #: COLMAP model id -> (name, number of parameters) (colmap/src/colmap/sensor/models.h)
 CAMERA_MODELS = {
@@ -65,23 +65,27 @@ def read_colmap_binary(model_dir) -> ColmapModel:
         name, n = CAMERA_MODELS[mid]
         cams[cid] = make_camera(cid, name, int(w), int(h), r.read(f"{n}d"))
     r = _Reader(d / "images.bin")
-    names, qs, ts, cids = [], [], [], []
+    names, qs, ts, cids, iids, points2d = [], [], [], [], [], []
     for _ in range(r.read("Q")[0]):
         vals = r.read("I4d3dI")
+        iids.append(vals[0])
         qs.append(vals[1:5])
         ts.append(vals[5:8])
         cids.append(vals[8])
         names.append(r.cstring())
-        r.skip(24 * r.read("Q")[0])  # points2D: x, y (double), point3D_id (int64)
+        n2 = r.read("Q")[0]  # points2D: x, y (double), point3D_id (int64)
+        points2d.append(np.asarray(r.read("ddq" * n2), np.float64).reshape(-1, 3)[:, :2] if n2 else np.zeros((0, 2)))
     R = rotations_from_quats(qs, d / "images.bin")
     poses = Poses(tuple(names), R, np.asarray(ts, dtype=np.float64).reshape(-1, 3))
     pts = np.zeros((0, 3))
+    tracks = []
     if (d / "points3D.bin").is_file():
         r = _Reader(d / "points3D.bin")
         rows = []
         for _ in range(r.read("Q")[0]):
             vals = r.read("Q3d3Bd")
             rows.append(vals[1:4])
-            r.skip(8 * r.read("Q")[0])  # track: image_id, point2D_idx (uint32 each)
+            nt = r.read("Q")[0]  # track: image_id, point2D_idx (uint32 each)
+            tracks.append(np.asarray(r.read("II" * nt), np.int64).reshape(-1, 2))
         pts = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
-    return ColmapModel(cams, poses, tuple(cids), pts)
+    return ColmapModel(cams, poses, tuple(cids), pts, *build_tracks(iids, points2d, tracks))

@@ -31,8 +31,8 @@ from recon_eval.metrics.poses import Poses
 from scenegen.dataset import CAMERAS, MANIFEST, Dataset, DatasetError
 from scenegen.dataset.crossview import VISIBLE, Correspondence, CrossviewIndex, MatchSet
 from scenegen.dataset.crossview_reader import TwoViewTruth
-from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, correspondence_path, mesh_path,
-                                     view_paths)
+from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, correspondence_path, flow_path,
+                                     mesh_path, view_paths)
 from scenegen.geometry.conventions import in_image
 
 #: Rectification tolerances of :meth:`DatasetTruth.disparity`: rotations equal to 1e-9 (JSON
@@ -269,6 +269,33 @@ class DatasetTruth:
         ok &= np.all(np.isfinite(x2), axis=1) & in_image(x2, cam2.width, cam2.height) & visible
         x1 = np.stack([uu, vv], axis=1).astype(np.float64)
         return x1[ok], x2[ok]
+
+    def flow_pairs(self) -> tuple:
+        """(i, j) of every flow pair the dataset holds, both directions, in index order (flow is
+        written between consecutive frames of a camera stream); NotApplicable without an index."""
+        return tuple(p for i, j in self.require_crossview_index().flow for p in ((i, j), (j, i)))
+
+    def flow_truth(self, view1: str, view2: str):
+        """``(flow (H, W, 2) float64 px, states (H, W) uint8 or None, source)`` of view1 -> view2:
+        the dataset's flow file when it has one (consecutive frames), else the correspondence
+        field ``uv - pixel`` of a crossview pair; the occlusion states from the correspondence file
+        when the dataset has it (None otherwise). NaN where the flow is unknown."""
+        self.check_view(view1)
+        self.check_view(view2)
+        has_corr = self._ds.crossview.has_correspondence(view1, view2)
+        corr = self._read(self._ds.crossview.correspondence, view1, view2) if has_corr else None
+        if self._ds.has(flow_path(view1, view2)):
+            flow = self._read(self._ds.crossview.flow, view1, view2).astype(np.float64)
+            source = str(flow_path(view1, view2))
+        elif corr is not None:
+            H, W = corr.shape
+            grid = np.stack(np.meshgrid(np.arange(W, dtype=np.float64), np.arange(H, dtype=np.float64)), -1)
+            flow, source = corr.uv - grid, str(correspondence_path(view1, view2)) + " (uv - pixel)"
+        else:
+            raise NotApplicable(f"{self._ds.path(flow_path(view1, view2))}: no such file, and no correspondence truth "
+                                f"for views {view1!r} -> {view2!r}: the dataset holds no flow for this pair")
+        flow[~np.all(np.isfinite(flow), axis=2)] = np.nan
+        return flow, None if corr is None else corr.state, source
 
     def twoview(self, view1: str, view2: str) -> TwoViewTruth:
         """The two-view geometry of a crossview pair (relative pose, E, F, plane homographies)."""

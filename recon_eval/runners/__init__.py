@@ -4,7 +4,8 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 :mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
-:mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching); shared:
+:mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
+:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
 the production methods; :data:`FAULTS` the deliberately broken ones of :mod:`.faults`, which gates
 must catch, run by name the same way.
@@ -71,6 +72,10 @@ METHODS: dict[str, Method] = {m.name: m for m in [
        "normalised linear DLT (H&Z Alg. 7.1, linear steps) on detected board corners and on noisy truth points"),
     _m("opencv-triangulate", "triangulate", "opencv",
        "cv2.triangulatePoints on noisy exact truth correspondences of the cross-view pairs (sigma 0 and 1 px)"),
+    _m("opencv-flow-dis", "flow", "dense", "cv2.DISOpticalFlow (preset medium) on the flow pairs", algorithm="dis"),
+    _m("opencv-flow-farneback", "flow", "dense", "cv2.calcOpticalFlowFarneback (tutorial parameters) on the flow pairs",
+       algorithm="farneback"),
+    _m("opencv-lk-tracks", "flow", "lk", "cv2.goodFeaturesToTrack + calcOpticalFlowPyrLK (21 px, 3 levels) tracks"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

@@ -295,3 +295,78 @@ crossview:
 def zero_baseline_spec():
     """A spec (YAML text) with a zero-baseline crossview pair and an ordinary one (renders: Mitsuba)."""
     return ZERO_BASELINE_SPEC
+
+
+# --- a two-frame flow dataset over the plane (no Mitsuba) -------------------------------------------
+FLOW_W, FLOW_H = 96, 72
+FLOW_CAM = Camera("pinhole", FLOW_W, FLOW_H, 80.0, 80.0, (FLOW_W - 1) / 2, (FLOW_H - 1) / 2)
+#: the second frame's camera: moved 0.12 m along x, 0.05 m along y and 0.2 m closer, rolled 2 degrees
+FLOW_MOTION = (np.array([0.12, 0.05, -0.2]), 2.0)
+
+
+def _flow_plane_truth(cam, pose) -> dict:
+    uv = np.stack(np.meshgrid(np.arange(cam.width, dtype=float), np.arange(cam.height, dtype=float)), -1).reshape(-1, 2)
+    wfc = pose.inverse()
+    d = cam.unproject_unit(uv) @ wfc.R.T
+    s = -wfc.t[2] / d[:, 2]
+    P = wfc.t + s[:, None] * d
+    Pc = pose.apply(P)
+    f = lambda a: a.reshape(cam.height, cam.width, *a.shape[1:]).astype(np.float32)  # noqa: E731
+    n = len(P)
+    return {"depth_z": f(Pc[:, 2]), "range": f(s), "points_world": f(P), "points_cam": f(Pc),
+            "normals_world": f(np.tile([0.0, 0.0, 1.0], (n, 1))), "normals_cam": f(np.tile(pose.R[:, 2], (n, 1))),
+            "uv": f(np.zeros((n, 2))), "object_id": np.ones((cam.height, cam.width), np.uint32),
+            "instance_id": np.ones((cam.height, cam.width), np.uint32), "valid": np.ones((cam.height, cam.width), bool)}
+
+
+def _texture(P) -> np.ndarray:
+    """A smooth, well-textured grey pattern on the plane (for the flow estimators)."""
+    rng = np.random.default_rng(11)
+    k = rng.normal(size=(16, 2))
+    k *= (rng.uniform(4.0, 16.0, 16) / np.linalg.norm(k, axis=1))[:, None]  # periods 0.4-1.6 m: 10-40 px
+    ph = rng.uniform(0, 2 * np.pi, 16)
+    g = 0.5 + 0.09 * np.sum(np.sin(P[..., :2] @ k.T + ph), axis=-1)
+    return np.repeat((255 * np.clip(g, 0, 1))[..., None], 3, axis=2).astype(np.uint8)
+
+
+def write_flow_dataset(root) -> dict:
+    """Two frames of camera "cam" over the plane, with flow both ways, the correspondence files of
+    the pair and a crossview index (flow pair and crossview pair). Returns {view: (Camera, pose)}."""
+    from scenegen.crossview.correspondence import flow_field
+    from scenegen.dataset.codecs import encode_flo, encode_json
+    from scenegen.dataset.crossview import INDEX_FORMAT, INDEX_FORMAT_VERSION
+    from scenegen.dataset.layout import CROSSVIEW_INDEX, flow_path
+
+    w = ds.DatasetWriter(root, spec_sha256="ef" * 32, seed=1, variant="test", versions={"numpy": "x"})
+    p0 = Rigid3(DOWN, -DOWN @ np.array([0.0, 0.0, HEIGHT_M]))
+    t, roll = FLOW_MOTION
+    Rr = Rotation.from_rotvec([0.0, 0.0, np.radians(roll)]).as_matrix()
+    p1 = Rigid3(Rr @ DOWN, -(Rr @ DOWN) @ (np.array([0.0, 0.0, HEIGHT_M]) + t))
+    vcs = {"cam_000": ds.ViewCamera(FLOW_CAM, p0, "cam", frame_index=0),
+           "cam_001": ds.ViewCamera(FLOW_CAM, p1, "cam", frame_index=1)}
+    w.write_cameras(vcs, {"objects": [{"name": "plane"}]})
+    w.write_mesh("plane", trimesh.Trimesh([[-9, -9, 0], [9, -9, 0], [9, 9, 0], [-9, 9, 0]], [[0, 1, 2], [0, 2, 3]],
+                                          process=False))
+    truths = {}
+    for name, vc in vcs.items():
+        tr = truths[name] = _flow_plane_truth(vc.camera, vc.cam_from_world)
+        img = _texture(tr["points_world"])
+        w.write_view(name, image=img, linear_rgb=img.astype(np.float32) / 255, truth=tr)
+    files = []
+    for i, j in (("cam_000", "cam_001"), ("cam_001", "cam_000")):
+        c = correspond(truths[i]["points_world"], vcs[j].camera, vcs[j].cam_from_world, nothing_occludes)
+        w.write_file(correspondence_path(i, j), encode_exr(encode_correspondence_channels(c)))
+        w.write_file(flow_path(i, j), encode_flo(flow_field(c)))
+        files += [correspondence_path(i, j), flow_path(i, j)]
+    index = {"format": INDEX_FORMAT, "format_version": INDEX_FORMAT_VERSION, "occlusion_rel_tol": 1e-4,
+             "pairs": [{"i": "cam_000", "j": "cam_001"}], "flow": [{"i": "cam_000", "j": "cam_001"}], "stereo": [],
+             "targets": [], "files": sorted(files)}
+    w.write_file(CROSSVIEW_INDEX, encode_json(index))
+    return {n: (vc.camera, vc.cam_from_world) for n, vc in vcs.items()}
+
+
+@pytest.fixture(scope="session")
+def flow_dataset(tmp_path_factory):
+    """(path, {view: (Camera, cam_from_world)}) of the two-frame flow dataset (written once)."""
+    root = tmp_path_factory.mktemp("flow") / "ds"
+    return root, write_flow_dataset(root)

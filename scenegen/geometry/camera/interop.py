@@ -97,7 +97,7 @@ def colmap_camera_args(model_name: str, width: int, height: int, params) -> tupl
     if model_name in ("SIMPLE_PINHOLE", "SIMPLE_RADIAL", "RADIAL"):
         f, cx, cy, *k = p
         fx = fy = f
-        dist = {"SIMPLE_PINHOLE": (), "SIMPLE_RADIAL": (k[0], 0, 0, 0), "RADIAL": (k[0], k[1], 0, 0)}[model_name]
+        dist = {"SIMPLE_PINHOLE": (), "SIMPLE_RADIAL": (*k[:1], 0, 0, 0), "RADIAL": (*k[:2], 0, 0)}[model_name]
     else:
         fx, fy, cx, cy, *dist = p
     cx, cy = opencv_from_colmap_pixels([cx, cy])

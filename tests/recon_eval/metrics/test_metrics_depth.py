@@ -65,5 +65,7 @@ def test_shape_mismatch():
 def test_depth_range_is_open():
     g = np.array([[1.0, 2.0, 3.0]])
     p = np.array([[1.0, 4.0, 3.0]])  # only the middle pixel is wrong
-    r = eigen_depth_metrics([p], [g], min_depth_m=1.0, max_depth_m=3.0)
+    r = eigen_depth_metrics([p], [g], min_depth_m=1.0, max_depth_m=3.0, clamp=False)
     assert r.abs_rel == 1.0  # 1 and 3 are outside (1, 3): only g = 2 is scored
+    # by default the prediction is clamped to [1, 3] first, as monodepth2 does: 4 -> 3
+    assert eigen_depth_metrics([p], [g], min_depth_m=1.0, max_depth_m=3.0).abs_rel == 0.5

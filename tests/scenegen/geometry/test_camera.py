@@ -219,3 +219,14 @@ class TestOpenCVAndColmapInterop:
         cam = Camera("pinhole", 64, 48, 50.0, 50.0, 31.5, 23.5, skew=1.0)
         with pytest.raises(ValueError, match="skew"):
             cam.to_colmap()
+
+
+def test_colmap_simple_radial_and_radial_cameras():
+    """COLMAP's one- and two-coefficient radial models (each dict entry used to be evaluated for
+    every model, so SIMPLE_RADIAL raised IndexError)."""
+    from scenegen.geometry.camera import Camera
+
+    a = Camera.from_colmap("SIMPLE_RADIAL", 640, 480, [500.0, 320.0, 240.0, -0.05])
+    b = Camera.from_colmap("RADIAL", 640, 480, [500.0, 320.0, 240.0, -0.05, 0.01])
+    assert a.model == b.model == "opencv" and a.dist[:2] == (-0.05, 0.0) and b.dist[:2] == (-0.05, 0.01)
+    assert (a.cx, a.cy) == (319.5, 239.5)
