@@ -12,6 +12,7 @@ import mitsuba as mi
 import numpy as np
 
 from scenegen.dataset.crossview import OCCLUSION_REL_TOL
+from scenegen.render.arrays import to_jit
 
 
 def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarray, np.ndarray]:
@@ -35,7 +36,7 @@ def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarra
 
 def _first_hits_vectorised(scene, o, d) -> np.ndarray:
     ray = mi.Ray3f(mi.Point3f(*[float(c) for c in o]),
-                   mi.Vector3f(d[:, 0].astype(np.float32), d[:, 1].astype(np.float32), d[:, 2].astype(np.float32)))
+                   mi.Vector3f(*[to_jit(mi.Float, d[:, i], np.float32) for i in range(3)]))
     si = scene.ray_intersect_preliminary(ray, coherent=False)
     hit = si.is_valid()
     t = dr.select(hit, si.t, dr.inf)

@@ -29,6 +29,7 @@ import numpy as np
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.pose import Rigid3
+from scenegen.render.arrays import to_jit
 
 
 @functools.lru_cache(maxsize=16)
@@ -42,7 +43,7 @@ def camera_rays(camera: Camera) -> np.ndarray:
 @functools.lru_cache(maxsize=16)
 def _camera_rays_dr(camera: Camera):
     r = camera_rays(camera)
-    return mi.Vector3d(r[:, 0], r[:, 1], r[:, 2])
+    return mi.Vector3d(*[to_jit(mi.Float64, r[:, i], np.float64) for i in range(3)])
 
 
 def shape_id_table(scene, object_ids: dict, instance_ids: dict):
@@ -62,7 +63,7 @@ def shape_id_table(scene, object_ids: dict, instance_ids: dict):
     for s, r in zip(shapes, reg):
         obj[r] = object_ids.get(s.id(), 0)
         inst[r] = instance_ids.get(s.id(), 0)
-    return mi.UInt32(obj), mi.UInt32(inst)
+    return to_jit(mi.UInt32, obj, np.uint32), to_jit(mi.UInt32, inst, np.uint32)
 
 
 def _matvec(R, v):
@@ -95,8 +96,9 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
         R_rows = np.stack([w.R for w in inv])  # (H, 3, 3) world_from_cam per row
         C_rows = np.stack([w.t for w in inv])  # (H, 3)
         row = dr.arange(mi.UInt32, H * W) // W
-        Rwc = [[dr.gather(mi.Float64, mi.Float64(R_rows[:, i, j]), row) for j in range(3)] for i in range(3)]
-        C = mi.Vector3d(*[dr.gather(mi.Float64, mi.Float64(C_rows[:, i]), row) for i in range(3)])
+        Rwc = [[dr.gather(mi.Float64, to_jit(mi.Float64, R_rows[:, i, j], np.float64), row) for j in range(3)]
+               for i in range(3)]
+        C = mi.Vector3d(*[dr.gather(mi.Float64, to_jit(mi.Float64, C_rows[:, i], np.float64), row) for i in range(3)])
     Rcw = [[Rwc[j][i] for j in range(3)] for i in range(3)]
 
     d_cam = _camera_rays_dr(camera)
