@@ -23,7 +23,7 @@ _HASH_CHUNK = 1 << 20  # bytes read at a time by sha256_file
 
 
 # --- atomic writes ----------------------------------------------------------------------------
-def _fsync_dir(directory: Path) -> None:
+def fsync_dir(directory: Path) -> None:
     """Make a rename in ``directory`` durable (no-op where directories cannot be opened)."""
     try:
         fd = os.open(directory, os.O_RDONLY)
@@ -61,7 +61,7 @@ def atomic_write(path, write_fn: Callable[[BinaryIO], None]) -> None:
         except FileNotFoundError:
             pass
         raise
-    _fsync_dir(path.parent)
+    fsync_dir(path.parent)
 
 
 def atomic_write_bytes(path, data: bytes) -> None:

@@ -26,8 +26,14 @@ MANIFEST_KEYS = IDENTITY_KEYS + ("views", "files", "manifest_sha256")
 def manifest_bytes(body: Mapping[str, Any]) -> bytes:
     """Canonical manifest bytes: ``body`` plus ``manifest_sha256``, the SHA-256 of the canonical
     JSON of ``body`` itself (so a changed byte anywhere in manifest.json is detected)."""
+    return manifest_bytes_and_sha256(body)[0]
+
+
+def manifest_bytes_and_sha256(body: Mapping[str, Any]) -> tuple[bytes, str]:
+    """:func:`manifest_bytes` and the ``manifest_sha256`` they hold."""
     body = {k: v for k, v in body.items() if k != "manifest_sha256"}
-    return encode_json({**body, "manifest_sha256": sha256_bytes(encode_json(body))})
+    sha = sha256_bytes(encode_json(body))
+    return encode_json({**body, "manifest_sha256": sha}), sha
 
 
 def manifest_integrity_error(data: bytes) -> tuple[dict | None, str | None]:
