@@ -57,9 +57,9 @@ class LoadedScene:
         return render_ideal(self, sensor_camera_name, camera, cam_from_world, spp=spp, seed=seed,
                             light_scales=light_scales)
 
-    def truth(self, camera, cam_from_world: Rigid3, row_poses=None) -> dict[str, np.ndarray]:
+    def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False) -> dict[str, np.ndarray]:
         """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
-        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses)
+        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored)
 
     def visible_from(self, center_world, points_world) -> np.ndarray:
         """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""

@@ -5,7 +5,10 @@ the reconstruction filter. Here each pixel centre (u, v) = (column, row) in Open
 is unprojected in float64 by :class:`scenegen.geometry.camera.Camera` (the same arithmetic as the
 renderer's sensor), rotated into the world, intersected with the scene in float32 by Mitsuba,
 and every output is derived in float64 in ONE Dr.Jit kernel (range and depth_z are returned in
-float64; points, normals and uv are rounded once to float32, the precision they are stored in):
+float64, or, with ``as_stored``, rounded to float32 in the kernel as the dataset stores them;
+points, normals and uv are rounded once to float32, the precision they are stored in). Vectors
+come back as (H, W, C) views of one channel-planar buffer, so each channel is a contiguous
+(H, W) plane: what the EXR encoder takes, without interleaving and splitting again.
 
 * ``range``: distance from the optical centre to the hit (metres) = Mitsuba's ``si.t`` along
   the unit ray; ``depth_z`` = range * ray_z, z along the optical axis (metres).
@@ -73,17 +76,21 @@ def _matvec(R, v):
 
 
 def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
-               row_poses: list[Rigid3] | None = None) -> dict[str, np.ndarray]:
+               row_poses: list[Rigid3] | None = None, as_stored: bool = False) -> dict[str, np.ndarray]:
     """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring.
 
     ``row_poses`` (rolling shutter): one ``cam_from_world`` per image row; each row's rays start
     from its own pose and ``points_cam``, ``normals_cam``, ``depth_z`` are in that row's camera
-    frame. Without it every row uses ``cam_from_world``.
+    frame. Without it every row uses ``cam_from_world``. ``as_stored``: range and depth_z in
+    float32 (the float64 values rounded to nearest, bit for bit what storing them gives).
     """
     if mi.variant().startswith("scalar"):
         if row_poses is not None:
             raise NotImplementedError("rolling-shutter truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
-        return _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
+        out = _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
+        if as_stored:
+            out.update({k: out[k].astype(np.float32) for k in ("range", "depth_z")})
+        return out
     H, W = camera.height, camera.width
     if row_poses is None:
         world_from_cam = cam_from_world.inverse()
@@ -122,16 +129,27 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     obj = dr.select(hit, dr.gather(mi.UInt32, obj_table, sid), 0)
     inst = dr.select(hit, dr.gather(mi.UInt32, inst_table, sid), 0)
     depth_z = dr.select(hit, t * d_cam.z, dr.inf)  # t * z is -inf or NaN for misses of rays at or beyond 90 degrees
+    if as_stored:  # range = si.t exactly; depth_z rounded once, as numpy's astype(float32) does
+        t, depth_z = mi.Float(t), mi.Float(depth_z)
     # vectors are rounded once to float32 (the stored precision) inside the kernel; range and
-    # depth_z stay float64, so float64 points are C + range * ray when a caller needs them
+    # depth_z stay float64 unless as_stored, so float64 points are C + range * ray when needed
     vectors = {"points_cam": mi.Vector3f(points_cam), "points_world": mi.Vector3f(points_world),
                "normals_world": mi.Vector3f(n_world), "normals_cam": mi.Vector3f(n_cam), "uv": uv}
     scalars = {"range": t, "depth_z": depth_z, "object_id": obj, "instance_id": inst, "valid": hit}
     dr.eval(*vectors.values(), *scalars.values())  # one kernel for everything; convert only afterwards
-    # .numpy() of an evaluated flat array is a zero-copy view; vectors are stacked per component
-    out = {k: np.stack([c.numpy() for c in v], axis=-1).reshape(H, W, len(v)) for k, v in vectors.items()}
+    # .numpy() of an evaluated flat array is a zero-copy view; a vector's channels are copied
+    # into one planar buffer, seen as (H, W, C) with every channel a contiguous plane
+    out = {k: _planar(v, H, W) for k, v in vectors.items()}
     out.update({k: v.numpy().reshape(H, W) for k, v in scalars.items()})
     return out
+
+
+def _planar(vector, H: int, W: int) -> np.ndarray:
+    """(H, W, C) float32 view of a (C, H, W) buffer holding the evaluated vector's components."""
+    buf = np.empty((len(vector), H, W), np.float32)
+    for i, c in enumerate(vector):
+        buf[i] = c.numpy().reshape(H, W)
+    return np.moveaxis(buf, 0, -1)
 
 
 def _flags():
