@@ -20,10 +20,10 @@ import os
 import secrets
 import zipfile
 from collections import OrderedDict
+from collections.abc import Callable
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
-from collections.abc import Callable
 
 import numpy as np
 
