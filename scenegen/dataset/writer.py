@@ -191,15 +191,20 @@ class DatasetWriter:
                            for v, e in m["views"].items()}
             self._files = dict(m["files"])
             journal = read_journal(self.root)
-            if journal is not None:
-                self._replay(pending_records(m, journal, str(self.root / MANIFEST_JOURNAL)))
+            records = [] if journal is None else pending_records(m, journal, str(self.root / MANIFEST_JOURNAL))
+            self._replay(records)
+            resumed_unchanged = not records  # manifest.json already holds this state, byte for byte
         elif self.root.exists() and any(self.root.iterdir()):
             if (self.root / MANIFEST_JOURNAL).is_file() and not has_manifest:
                 hint = f"it has a {MANIFEST_JOURNAL} but no {MANIFEST}: the manifest was removed"
             else:
                 hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
             raise DatasetError(f"{self.root} is not empty ({hint}); use a new or empty directory")
-        self._write_manifest()
+        if resume and has_manifest and resumed_unchanged:
+            self._manifest_sha = m["manifest_sha256"]  # no rewrite of a large manifest to the same bytes
+            remove_journal(self.root)  # a stale one
+        else:
+            self._write_manifest()
 
     # --- state
     def is_complete(self, view: str) -> bool:

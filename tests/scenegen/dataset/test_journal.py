@@ -239,3 +239,20 @@ def test_sigkill_inside_a_journal_write_then_resume(tmp_path, complete):
     assert ds.Dataset(out).views == tuple(VIEWS[:2])
     resume_to_end(out)
     assert all_bytes(out) == all_bytes(complete) and ds.verify(out).ok
+
+
+def test_manifest_bytes_encode_once_as_defined():
+    """manifest_bytes encodes the body once and inserts the hash line: the defined bytes."""
+    from scenegen.dataset.codecs.json import encode_json
+    from scenegen.dataset.files import sha256_bytes
+    from scenegen.dataset.manifest import manifest_bytes
+
+    def defined(body):
+        return encode_json({**body, "manifest_sha256": sha256_bytes(encode_json(body))})
+
+    views = {f"v{i}": {"status": "complete", "files": [f"a/{i}.png"]} for i in range(3)}
+    base = {"format": "f", "format_version": 1, "seed": 3, "spec_sha256": "0" * 64, "variant": "v",
+            "versions": {"seed": "x"}, "views": views, "files": {f"a/{i}.png": "0" * 64 for i in range(3)}}
+    for body in (base, {**base, "nested": {"seed": 1}}, {**base, "r": 1}, {k: v for k, v in base.items() if k != "seed"},
+                 {"seed": 1}, {}):
+        assert manifest_bytes(body) == defined(body)
