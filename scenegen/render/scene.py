@@ -17,7 +17,7 @@ from scenegen.render import raycast, sensor as sensor_mod
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entry
-from scenegen.render.truth import shape_id_table, truth_pass
+from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 
 
@@ -105,4 +105,6 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     built.light_scales = (1.0,) * len(spec.lights)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
+    for cam in built.cameras.values():
+        prepare_camera(cam)  # the truth pass's ray table, made here rather than in frame 0
     return built
