@@ -10,7 +10,7 @@ Also printed: the serial pipeline (writing on the render's thread, as before the
 and the CPU accounting that bounds any overlap on this machine: with the render using c cores
 of n, the frame cannot be shorter than (render CPU + the rest's CPU) / n.
 
-Run: .venv/bin/python benchmarks/bench_frame.py [--reps 3] [--views 8]
+Run: .venv/bin/python benchmarks/bench_frame.py [--reps 3] [--views 8] [--spp 16 4] [--render-threads N]
 """
 from __future__ import annotations
 
@@ -29,6 +29,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--views", type=int, default=8)
+    ap.add_argument("--spp", type=int, nargs="+", default=[16, 4])
+    ap.add_argument("--render-threads", type=int, help="Dr.Jit threads (default: all cores); fewer leaves"
+                    " cores to the writer thread, showing what the overlap does when the render leaves room")
     args = ap.parse_args(argv)
 
     from scenegen.dataset import DatasetWriter
@@ -42,8 +45,12 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="bench_frame_"))
     runs = [0]
 
-    for spp in (spec.render.spp, 4):
+    for spp in args.spp:
         built = load_scene(spec, spp=spp)
+        if args.render_threads:
+            import drjit as dr  # after load_scene: the libLLVM is chosen first
+
+            dr.set_thread_count(args.render_threads)
         cam = built.cameras[views[0].camera]
         seed = spec.render.seed
 
@@ -85,7 +92,8 @@ def main(argv=None) -> int:
         util_r, cpu_r = cpu(render_only)
         util_f, cpu_f = cpu(lambda: pipeline(True))
         n = len(views)
-        print(f"demo {cam.width}x{cam.height}, {spp} spp, {n} views, {load()}")
+        threads = f", render on {args.render_threads} thread(s)" if args.render_threads else ""
+        print(f"demo {cam.width}x{cam.height}, {spp} spp, {n} views{threads}, {load()}")
         print(f"  render alone {fmt(r['render'], ' ms', 1e3, 1)}; frame (writer thread) {fmt(r['frame'], ' ms', 1e3, 1)};"
               f" serial frame {fmt(r['serial'], ' ms', 1e3, 1)}")
         print(f"  CPU: render {1e3 * cpu_r / n:.0f} ms/frame ({util_r:.2f} cores busy), whole frame"
