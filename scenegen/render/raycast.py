@@ -79,7 +79,10 @@ def _visible_vectorised(scene, C, P, rel_tol: float) -> np.ndarray:
     v = [to_jit(mi.Float64, P[:, i], np.float64) - c64[i] for i in range(3)]
     dist = dr.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     d = mi.Vector3f(*[mi.Float(vi / dist) for vi in v])
-    si = scene.ray_intersect_preliminary(mi.Ray3f(_origin(C), d), coherent=True)
+    # coherent=False, as before: Embree's coherent mode is ~1.5x faster on these pixel-ordered rays
+    # but decides a grazing ray differently (one pixel of scenes/triangulation_baselines.yaml
+    # turned from occluded to visible), and the bytes must not change
+    si = scene.ray_intersect_preliminary(mi.Ray3f(_origin(C), d), coherent=False)
     t = dr.select(si.is_valid(), mi.Float64(si.t), dr.inf)
     visible = t >= dist * (1.0 - rel_tol)
     dr.eval(visible)
