@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.py", "bench_fscore.py",
+BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.py", "bench_codecs.py", "bench_fscore.py",
            "bench_scale.py")
 
 
