@@ -24,7 +24,7 @@ from scenegen.dataset.codecs.json import decode_json, encode_json
 from scenegen.dataset.codecs.ply import encode_ply
 from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
-from scenegen.dataset.files import atomic_write_bytes, remove_stale_temp_files, sha256_bytes
+from scenegen.dataset.files import atomic_write_bytes, atomic_write_files, remove_stale_temp_files, sha256_bytes
 from scenegen.dataset.journal import (
     JournalAppender,
     file_record,
@@ -102,10 +102,8 @@ def write_view_files(out_dir, view: str, *, image, linear_rgb, truth,
     files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
     files.update(_checked_extra_files(view, extra_files, files))
     root = Path(out_dir)
-    hashes = {}
-    for rel, data in files.items():
-        atomic_write_bytes(root / rel, data)
-        hashes[rel] = sha256_bytes(data)
+    hashes = {rel: sha256_bytes(data) for rel, data in files.items()}
+    atomic_write_files({root / rel: data for rel, data in files.items()})
     return hashes
 
 
@@ -270,8 +268,7 @@ class DatasetWriter:
         files.update(_checked_extra_files(view, extra_files, files))
         hashes = {rel: sha256_bytes(d) for rel, d in files.items()}
         self._check_rerecord(view, hashes)  # before writing anything
-        for rel, data in files.items():
-            atomic_write_bytes(self.root / rel, data)
+        atomic_write_files({self.root / rel: data for rel, data in files.items()})  # durable, then recorded
         self.record_view(view, hashes)
 
     def record_view(self, view: str, file_hashes: Mapping[str, str]) -> None:

@@ -1,5 +1,6 @@
 """scenegen.dataset: layout, determinism, resume after a crash, reader round trip, verify."""
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -172,20 +173,20 @@ class TestResume:
     def test_resume_after_kill_equals_uninterrupted(self, tmp_path, complete, monkeypatch):
         out = tmp_path / "b"
         write_dataset(out, views=VIEWS[:2])
-        # a "kill" in the middle of the third view: two of its files written, then death
-        real, calls = files.atomic_write_bytes, []
+        # a "kill" in the middle of the third view: two of its files in place, then death
+        real, calls = os.replace, []
 
-        def dying(path, data):
-            if Path(path).name != "manifest.json":
-                calls.append(path)
+        def dying(src, dst):
+            if Path(dst).name != "manifest.json":
+                calls.append(dst)
             if len(calls) == 3:
                 raise KeyboardInterrupt("SIGKILL stand-in")
-            real(path, data)
+            real(src, dst)
 
-        monkeypatch.setattr(writer_module, "atomic_write_bytes", dying)
+        monkeypatch.setattr(os, "replace", dying)
         with pytest.raises(KeyboardInterrupt):
             new_writer(out, resume=True).write_view(VIEWS[2], **make_view(2))
-        monkeypatch.setattr(writer_module, "atomic_write_bytes", real)
+        monkeypatch.setattr(os, "replace", real)
         (out / "truth" / f".x.exr.123{files.TEMP_SUFFIX}").write_bytes(b"half")  # a killed temp file
 
         m = sio.read_json(out / "manifest.json")
@@ -347,17 +348,12 @@ sys.path.insert(0, sys.argv[2])
 from scenegen.dataset import files
 import test_dataset as t
 
-real = files.atomic_write
+real = files.write_payload
 
-def slow(path, write_fn):
-    def halves(f):  # be killable between the two halves of every file
-        class Half:
-            def write(self, b):
-                f.write(b[: len(b) // 2]); f.flush(); time.sleep(0.01); f.write(b[len(b) // 2:])
-        write_fn(Half())
-    real(path, halves)
+def slow(f, data):  # be killable between the two halves of every file
+    f.write(data[: len(data) // 2]); f.flush(); time.sleep(0.01); real(f, data[len(data) // 2:])
 
-files.atomic_write = slow
+files.write_payload = slow
 t.write_dataset(t.Path(sys.argv[1]))
 print("finished")
 """

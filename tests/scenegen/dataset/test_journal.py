@@ -256,3 +256,33 @@ def test_manifest_bytes_encode_once_as_defined():
     for body in (base, {**base, "nested": {"seed": 1}}, {**base, "r": 1}, {k: v for k, v in base.items() if k != "seed"},
                  {"seed": 1}, {}):
         assert manifest_bytes(body) == defined(body)
+
+
+def test_atomic_write_files_all_or_renamed_complete(tmp_path, monkeypatch):
+    """A view's files: written and fsync'd, renamed, directories fsync'd once; a failure leaves
+    only complete renamed files and no temporary file."""
+    from scenegen.dataset import files
+
+    items = {tmp_path / "a" / f"f{i}.bin": bytes([i]) * (1000 + i) for i in range(4)}
+    items[tmp_path / "b" / "g.bin"] = b"g" * 10
+    synced = []
+    monkeypatch.setattr(files, "fsync_dir", lambda d: synced.append(d))
+    files.atomic_write_files(items)
+    assert all(p.read_bytes() == d for p, d in items.items())
+    assert sorted(synced) == [tmp_path / "a", tmp_path / "b"]  # once per directory
+    real, n = os.replace, []
+
+    def dying(src, dst):
+        n.append(dst)
+        if len(n) == 3:
+            raise KeyboardInterrupt
+        real(src, dst)
+
+    monkeypatch.setattr(os, "replace", dying)
+    new = {p.with_name("new_" + p.name): b"new" + d for p, d in items.items()}
+    with pytest.raises(KeyboardInterrupt):
+        files.atomic_write_files(new)
+    monkeypatch.setattr(os, "replace", real)
+    done = [p for p in new if p.exists()]
+    assert len(done) == 2 and all(p.read_bytes() == new[p] for p in done)
+    assert not list(tmp_path.rglob(f"*{files.TEMP_SUFFIX}"))
