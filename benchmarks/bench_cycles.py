@@ -69,6 +69,7 @@ def main(argv=None) -> int:
     ap.add_argument("--keep", metavar="DIR", help="save both images there as .npy")
     ap.add_argument("--plan", action="store_true", help="also measure what the plan for 0.25 x Cycles rests on")
     ap.add_argument("--frames", type=int, default=5, help="frames of the whole-frame measurement")
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of Mitsuba and Cycles timings")
     args = ap.parse_args(argv)
     if args.setup:
         return setup()
@@ -107,7 +108,7 @@ def main(argv=None) -> int:
         times.append(time.perf_counter() - t)
     mi_warm = min(times)
     img_a, img_b = render(11), render(12)  # two seeds: Mitsuba's own noise
-    frame = whole_frame(spec, built, view, args.spp, args.frames)
+    whole_frame(spec, built, view, args.spp, 2)  # warm: the writer thread's first use
     plan = mitsuba_plan(spec, built, view, args, render) if args.plan else []
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -143,6 +144,13 @@ def main(argv=None) -> int:
             np.savez(Path(tmp) / "quarter.npz", **quarter)
             cq = cycles(Path(tmp) / "quarter.npz")
         cy = cycles(npz)
+        # interleaved rounds, the machine's load drifting: Mitsuba render (best of 2), the whole
+        # frame, Cycles (best of its 2 warm renders); ratios per round
+        rounds = []
+        for _ in range(args.rounds):
+            m = min(_timed(lambda: render(5)) for _ in range(2))
+            f = whole_frame(spec, built, view, args.spp, args.frames)
+            rounds.append((m, f, cycles(npz)["warm_s"]))
 
         ch = sio.read_exr(exr)
         img_c = np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float64)
@@ -160,10 +168,11 @@ def main(argv=None) -> int:
           f"{args.max_depth} (Cycles bounces {args.max_depth - 2}), box filter, 2 threads, no denoising")
     print(f"  warm time: Mitsuba {mi_warm:.3f} s, Cycles {cy['warm_s']:.3f} s -> Cycles / Mitsuba = "
           f"{cy['warm_s'] / mi_warm:.2f} (cold: {mi_cold:.2f} s vs {cy['cold_s']:.2f} s) [{load()}]")
-    print(f"  whole frame (render, truth, encode, write; steady, {args.frames} frames): {frame:.3f} s ="
-          f" {frame / mi_warm:.2f} x the render")
-    print("  " + target("Mitsuba render / Cycles", [mi_warm / cy["warm_s"]], 0.4))
-    print("  " + target("Mitsuba whole frame / Cycles", [frame / cy["warm_s"]], 0.4))
+    print(f"  {args.rounds} interleaved rounds (Mitsuba render, whole frame: render, truth, encode, write, steady over"
+          f" {args.frames} frames; Cycles): " + "; ".join(f"{m:.3f} / {f:.3f} / {c:.3f} s" for m, f, c in rounds))
+    print("  " + target("Mitsuba render / Cycles", [m / c for m, f, c in rounds], 0.4))
+    print("  " + target("Mitsuba whole frame / Cycles", [f / c for m, f, c in rounds], 0.4))
+    print("  whole frame / render: " + ", ".join(f"{f / m:.2f}" for m, f, c in rounds))
     print(f"  mean image value: Mitsuba {np.mean(a):.4f}, Cycles {np.mean(c):.4f} (ratio {np.mean(c) / np.mean(a):.4f})")
     print(f"  relative MAD: Mitsuba seed vs seed {rel_mad(a, b):.4f}; Mitsuba vs Cycles {rel_mad(a, c):.4f}")
     blur = lambda x: x.reshape(H // 8, 8, W // 8, 8, 3).mean(axis=(1, 3))  # 8x8 means: noise averages out
@@ -196,6 +205,12 @@ def whole_frame(spec, built, view, spp: int, frames: int) -> float:
                 handed.append(time.perf_counter())
         w.close()
     return (handed[-1] - handed[0]) / frames
+
+
+def _timed(fn) -> float:
+    t = time.perf_counter()
+    fn()
+    return time.perf_counter() - t
 
 
 def _best(fn, n: int = 3) -> float:
