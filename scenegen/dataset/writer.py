@@ -141,6 +141,7 @@ class DatasetWriter:
             if w.is_complete(view):
                 continue                                  # done by an earlier, interrupted run
             w.write_view(view, image=img, linear_rgb=lin, truth=truth)
+        w.close()                                         # the journal compacted into manifest.json
 
     ``resume=False`` needs ``out_dir`` absent or empty. ``resume=True`` loads an existing manifest,
     which must have been written with the same spec_sha256, seed, variant, format and versions
