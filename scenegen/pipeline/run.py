@@ -4,6 +4,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,6 +79,8 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     """
     source = spec_path if isinstance(spec_path, SpecSource) else None
     spec = source.load() if source is not None else load_spec(spec_path)
+    for w in spec.warnings:  # e.g. a spec material replacing a mesh file's own materials
+        print(f"warning: {w}", file=sys.stderr)
     views = resolve_views(spec)
     n_frames = 1 + max((v.frame_index for v in views), default=-1)
     wanted = parse_frames(frames, n_frames)
