@@ -48,8 +48,8 @@ class SurfaceMaps:
     normal_map: Texture | None = part(None, unit="tangent-space normal map image (linear RGB, "
                                       "2c - 1; +x along u, +y along v = down the image)")
     bump_map: Texture | None = part(None, unit="height map (its first channel, in [0, 1])")
-    bump_scale: float = param(1.0, unit="height per unit of the map (UV units)", lo=0.0,
-                              lo_open=True)
+    bump_scale: float = param(1.0, unit="metres of displacement per unit of the map's value",
+                              lo=0.0, lo_open=True)  # Mitsuba's bumpmap scale
     alpha: Texture | None = part(None, unit="opacity map (its first channel, in [0, 1])")
     alpha_cutoff: float = param(0.5, unit="opacity", lo=0.0, hi=1.0, lo_open=True)  # texels at
     # or above it are surface (opacity 1), below it holes (opacity 0)
