@@ -92,6 +92,13 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
 
     t0 = time.perf_counter()
     built = load_scene(spec, variant=variant or rs.variant, spp=spp)
+    for name, cam in built.cameras.items():
+        if cam.mask_beyond_fold:
+            n = int(cam.no_ray_mask().sum())
+            print(f"camera {name!r}: {n} of {cam.width * cam.height} pixels "
+                  f"({100 * n / (cam.width * cam.height):.2f} %) lie beyond the distortion's fold "
+                  "radius (mask_beyond_fold): no ray, black, invalid in every truth map",
+                  file=sys.stderr)
     used = RenderSettingsUsed(spp=spp, spp_effective=effective_spp(rs.sampler, spp), seed=seed,
                               variant=built.variant, sampler=rs.sampler, max_depth=rs.max_depth,
                               bit_depth=rs.bit_depth)

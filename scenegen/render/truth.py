@@ -105,6 +105,7 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
         if row_poses is not None:
             raise NotImplementedError("rolling-shutter truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
         out = _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
+        mark_no_ray(out, camera.no_ray_mask())
         if as_stored:
             out.update({k: out[k].astype(np.float32) for k in ("range", "depth_z")})
         return out
@@ -162,7 +163,28 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     # .numpy() of an evaluated flat array is a zero-copy view: (C, H, W) seen as (H, W, C)
     out = {k: np.moveaxis(b.numpy().reshape(len(vectors[k]), H, W), 0, -1) for k, b in planar.items()}
     out.update({k: v.numpy().reshape(H, W) for k, v in scalars.items()})
+    if camera.mask_beyond_fold:
+        mark_no_ray(out, camera.no_ray_mask())
     return out
+
+
+def mark_no_ray(out: dict, no_ray: np.ndarray) -> None:
+    """Pixels without a ray (beyond a distortion's fold radius): invalid in every truth map, as
+    the dataset stores a miss (valid False, range and depth_z +inf, vectors NaN, ids 0);
+    :meth:`scenegen.geometry.camera.Camera.no_ray_mask` tells them from misses."""
+    if not no_ray.any():
+        return
+    for k, v in list(out.items()):
+        if not v.flags.writeable:
+            out[k] = v = v.copy()
+        if k in ("object_id", "instance_id"):
+            v[no_ray] = 0
+        elif k == "valid":
+            v[no_ray] = False
+        elif k in ("range", "depth_z"):
+            v[no_ray] = np.inf
+        else:
+            v[no_ray] = np.nan
 
 
 def _planar(vector, n: int):

@@ -108,7 +108,7 @@ CASES = [
        lambda s, k=k: getattr(s.lights[0], k), v)
       for k, v in (("scale", 2.0), ("rotation_z_deg", 45.0))],
     *[(m.CameraSpec, k, CAM, lambda s, k=k: getattr(s.cameras["cam"], k), v)
-      for k, v in (("model", "opencv"), ("skew", 1.0), ("fov_deg", 60.0))],
+      for k, v in (("model", "opencv"), ("skew", 1.0), ("fov_deg", 60.0), ("mask_beyond_fold", True))],
     *[(optics.Shutter, k, CAM.replace("fx: 50", "fx: 50, shutter: {}"),
        lambda s, k=k: getattr(s.cameras["cam"].optics.shutter, k), v)
       for k, v in (("exposure_s", 0.01), ("rolling_readout_s", 0.001))],
