@@ -53,7 +53,7 @@ class AssetMaterial:
     metallic: float | None = None  # glTF metallicFactor (None: not a PBR material)
     roughness: float | None = None  # glTF roughnessFactor (perceptual, alpha = roughness^2)
     metallic_roughness_texture: np.ndarray | None = None  # (H, W, 3) linear, B metallic, G roughness
-    normal_texture: np.ndarray | None = None  # (H, W, 3) in [0, 1], tangent space, +y = -v
+    normal_texture: np.ndarray | None = None  # (H, W, 3) in [0, 1], tangent space, +y up the image
     bump_texture: np.ndarray | None = None  # (H, W) heights in [0, 1]
     bump_scale: float = 1.0
     emissive: tuple = (0.0, 0.0, 0.0)  # linear RGB radiance factor (multiplies emissive_texture)

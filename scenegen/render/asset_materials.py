@@ -54,7 +54,7 @@ def asset_bsdf(am) -> dict:
     else:
         bsdf = {"type": "diffuse", "reflectance": _base(am)}
     bsdf = with_bump_map(bsdf, am.bump_texture, am.bump_scale)
-    bsdf = with_normal_map(bsdf, am.normal_texture, flip_green=am.source == "gltf")
+    bsdf = with_normal_map(bsdf, am.normal_texture)
     if am.double_sided:
         bsdf = {"type": "twosided", "bsdf": bsdf}
     return with_alpha(bsdf, am.opacity, am.opacity_texture, am.alpha_mode, am.alpha_cutoff)

@@ -119,16 +119,13 @@ def _map_values(texture) -> np.ndarray:
 OPAQUE_AT = 0.5
 
 
-def with_normal_map(bsdf: dict, normals01: np.ndarray | None, flip_green: bool = False) -> dict:
-    """Wrap in Mitsuba's ``normalmap`` (tangent space, x along dP/du, y along dP/dv, values
-    2 c - 1). glTF's +y points up the image (towards smaller v): ``flip_green`` turns it into
-    Mitsuba's +dP/dv."""
+def with_normal_map(bsdf: dict, normals01: np.ndarray | None) -> dict:
+    """Wrap in Mitsuba's ``normalmap``: values 2 c - 1 in the shading frame, +x along dP/du,
+    +y = n x (+x) (UP the image for an unmirrored texture: the OpenGL and glTF convention), +z
+    along n. Mitsuba also applies the bump-terminator shadowing of Estevez et al. 2019."""
     if normals01 is None:
         return bsdf
-    img = np.array(normals01, dtype=np.float32)
-    if flip_green:
-        img[..., 1] = 1.0 - img[..., 1]
-    return {"type": "normalmap", "normalmap": bitmap(img), "bsdf": bsdf}
+    return {"type": "normalmap", "normalmap": bitmap(np.asarray(normals01, dtype=np.float32)), "bsdf": bsdf}
 
 
 def with_bump_map(bsdf: dict, heights: np.ndarray | None, scale: float) -> dict:

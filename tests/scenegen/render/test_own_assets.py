@@ -215,3 +215,74 @@ def test_a_gltf_uri_outside_its_folder_is_refused(tmp_path):
     spec_path.write_text("name: g\nobjects:\n  - {name: m, mesh: asset/m.gltf}\n")
     with pytest.raises(SpecError, match=r"m.gltf:3: buffers\[0\].uri '../../x.bin': leaves"):
         load_spec(spec_path)
+
+
+@pytest.mark.render
+def test_gltf_normal_texture_is_the_spec_normal_map(tmp_path):
+    """glTF's normalTexture (+y up the image) is the spec's `normal_map` convention, unflipped:
+    the glTF renders exactly as the same mesh with a spec principled material and that map."""
+    from PIL import Image
+
+    n = np.array([0.3, 0.45, 0.0])
+    n[2] = np.sqrt(1 - n @ n)
+    nmap = np.tile(np.round((n + 1) / 2 * 255).astype(np.uint8), (4, 4, 1))
+    cv2.imwrite(str(tmp_path / "n.png"), nmap[..., ::-1])
+    tex = write_texture(tmp_path)
+    write_glb(tmp_path, tex, metallicFactor=0.0, roughnessFactor=0.6, normalTexture=Image.fromarray(nmap))
+    lights = "lights:\n  - {type: point, position: [-2, 3, 6], intensity: 40}\n"
+    glb, ref = [], []
+    for tag, extra, out in (("gn", "", glb), ("gs", "    material: {type: principled, texture: {type: image, path: tex.png}, "
+                                                 "roughness: 0.6, normal_map: n.png}\n", ref)):
+        text = SCENE.format(tag=tag, mesh="quad.glb", extra=extra).replace(
+            "lights:\n  - {type: constant, radiance: 1.0}\n", lights)
+        (tmp_path / f"{tag}.yaml").write_text(text)
+        assert main(["render", str(tmp_path / f"{tag}.yaml"), "-o", str(tmp_path / tag), "-q"]) == 0
+        ds = Dataset(tmp_path / tag)
+        out.append(ds.linear_image(ds.views[0]))
+    np.testing.assert_allclose(glb[0], ref[0], atol=1e-6)
+
+
+@pytest.mark.render
+def test_gltf_alpha_mask_truth_follows_the_holes(tmp_path):
+    """alphaMode MASK: texels under alphaCutoff are holes in the image AND in the truth."""
+    from PIL import Image
+
+    rgba = np.zeros((4, 4, 4), np.uint8)
+    rgba[..., 0] = 230
+    rgba[..., 3] = 255
+    rgba[::2, ::2, 3] = rgba[1::2, 1::2, 3] = 20  # holes (alpha 0.08 < cutoff 0.5)
+    m = trimesh.Trimesh(vertices=[[-1, -0.5, 0.4], [1, -0.5, 0.4], [1, 0.5, 0.4], [-1, 0.5, 0.4]],
+                        faces=[[0, 1, 2], [0, 2, 3]], process=False)
+    mat = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.fromarray(rgba, "RGBA"),
+                                              alphaMode="MASK", alphaCutoff=0.5, metallicFactor=0.0)
+    m.visual = trimesh.visual.TextureVisuals(uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), material=mat)
+    m.export(tmp_path / "mask.glb")
+    extra = ("  - name: back\n    shape: {type: plane, size: [4, 3]}\n"
+             "    material: {type: diffuse, color: [0.05, 0.05, 0.8]}\n")
+    ds, img, truth = render(tmp_path, "mask", "mask.glb", extra)
+    oid = truth["object_id"]
+    assert set(np.unique(oid)) == {1, 2}
+    # wherever a pixel's whole 3x3 neighbourhood sees one surface (texel edges do not fall on
+    # pixel edges here, and the image averages over the pixel), the image shows the truth's surface
+    pad = np.pad(oid, 1, mode="edge")
+    shifts = [pad[1 + dr:1 + dr + oid.shape[0], 1 + dc:1 + dc + oid.shape[1]]
+              for dr in (-1, 0, 1) for dc in (-1, 0, 1)]
+    interior = np.all([sh == oid for sh in shifts], axis=0)
+    assert interior.mean() > 0.8
+    np.testing.assert_array_equal((oid == 1)[interior], (img[..., 0] > img[..., 2])[interior])
+    # the pattern: quad texel (i, j) covers x in [-1 + j/2, -1 + (j+1)/2], y in [0.5 - (i+1)/4, 0.5 - i/4]
+    for i in range(4):
+        for j in range(4):
+            r, c = pixel((-1 + (j + 0.5) / 2) * 1.6 / 1.2, (0.5 - (i + 0.5) / 4) * 1.6 / 1.2)  # z = 0.4
+            assert oid[r, c] == (2 if rgba[i, j, 3] < 128 else 1), (i, j)
+
+
+@pytest.mark.render
+def test_mtl_specular_and_emission(tmp_path, capsys):
+    """Ks/Ns (roughplastic) and Ke (an area emitter on the part) render: the emissive part's
+    radiance is its Ke plus its reflection (no light in the scene but the constant one at 0)."""
+    write_texture(tmp_path)
+    write_obj(tmp_path, "newmtl plain\nKd 0.2 0.5 0.7\nKs 0.5 0.5 0.5\nNs 80\n"
+                        "newmtl tex\nKd 0 0 0\nKe 0.3 0.6 0.9\n")
+    _, img, _ = render(tmp_path, "emis", "quad.obj")
+    np.testing.assert_allclose(img[pixel(0.5, 0)], [0.3, 0.6, 0.9], atol=1e-3)

@@ -155,6 +155,17 @@ lights:
     assert np.all(truth["object_id"].reshape(-1)[hit] == 1)
 
 
+def terminator_shadowing(n_perturbed, to_light):
+    """The bump-terminator shadowing Mitsuba's normalmap and bumpmap apply (Estevez, Kulla et
+    al., "A Microfacet-Based Shadowing Function to Solve the Bump Terminator Problem", Ray
+    Tracing Gems 2019): G = 2 / (1 + sqrt(1 + alpha^2 tan^2(theta_i))), alpha^2 = tan^2(d) / 8,
+    d the angle between the perturbed and the surface normal (+z here)."""
+    cos_d = min(abs(n_perturbed[2]), 1.0)
+    alpha2 = np.clip(0.125 * (1 - cos_d**2) / cos_d**2, 0.0, 1.0)
+    cos_i = np.maximum(np.abs(to_light[..., 2]), 1e-6)
+    return 2.0 / (1.0 + np.sqrt(1.0 + alpha2 * (1 - cos_i**2) / cos_i**2))
+
+
 def write_png16(path, rgb01):
     img = np.round(np.asarray(rgb01) * 65535).astype(np.uint16)
     cv2.imwrite(str(path), img[..., ::-1] if img.ndim == 3 else img)
@@ -164,14 +175,16 @@ def write_png16(path, rgb01):
 @pytest.mark.render
 @pytest.mark.parametrize("kind", ["normal_map", "bump_map"])
 def test_normal_and_bump_maps_tilt_the_shading(tmp_path, kind):
-    """A 2 m x 2 m plane (u along world +x) lit by a point light high above: the radiance ratio
-    to the unmapped plane is (n' . l) / (n . l) per pixel, n' the map's normal (direct light of a
-    point source is noise-free). A normal map's tangent-space +x is along u (world +x here); a
-    bump map of heights h(u) = u with scale s displaces s h metres along n: over the plane's 2 m
-    per UV unit that is a slope s / 2, n' ~ (-s / 2, 0, 1)."""
+    """A 2 m x 2 m plane (texture upright: u along world +x, the image's top towards +y) lit by a
+    point light off to one side: the radiance ratio to the unmapped plane is (n' . l) / (n . l)
+    per pixel (direct light of a point source is noise-free), times Mitsuba's bump-terminator
+    shadowing (:func:`terminator_shadowing`). A normal map's tangent space: +x
+    along u, +y = n x (+x), UP the image (world +y here), +z along n. A bump map of heights
+    h(u) = u with scale s displaces s h metres along n: over the plane's 2 m per UV unit that is a
+    slope s / 2, so n' ~ (-s / 2, 0, 1). The light's offset makes the sign of each tilt count."""
     if kind == "normal_map":
-        tilt = np.radians(40.0)
-        n = np.array([np.sin(tilt), 0.0, np.cos(tilt)])
+        n = np.array([np.sin(np.radians(25.0)), np.sin(np.radians(30.0)), 0.0])
+        n[2] = np.sqrt(1 - n[0] ** 2 - n[1] ** 2)
         stored = write_png16(tmp_path / "map.png", np.tile((n + 1) / 2, (4, 4, 1)))
         n_map = 2 * stored[0, 0] - 1
         extra = "normal_map: map.png"
@@ -182,15 +195,17 @@ def test_normal_and_bump_maps_tilt_the_shading(tmp_path, kind):
         n_map = np.array([-scale / 2, 0.0, 1.0])
         extra = f"bump_map: map.png, bump_scale: {scale}"
     n_map = n_map / np.linalg.norm(n_map)
-    light = np.array([0.0, 0.0, 40.0])
-    lights = "lights:\n  - {type: point, position: [0, 0, 40], intensity: 1600}\n"
+    light = np.array([-6.0, 8.0, 20.0])
+    lights = f"lights:\n  - {{type: point, position: {light.tolist()}, intensity: 1600}}\n"
     base = "render: {spp: 4, max_depth: 2}\nobjects:\n  - name: p\n    shape: {type: plane, size: [2, 2]}\n"
     _, flat, _ = render(tmp_path, "flat", base + "    material: {type: diffuse, color: 0.5}\n" + lights)
     _, tilted, truth = render(tmp_path, kind, base + f"    material: {{type: diffuse, color: 0.5, {extra}}}\n" + lights)
     ratio = tilted[24:40, 24:40, 0] / flat[24:40, 24:40, 0]
     p = truth["points_world"][24:40, 24:40].astype(np.float64)
     to_light = (light - p) / np.linalg.norm(light - p, axis=-1, keepdims=True)
-    want = (to_light @ n_map) / to_light[..., 2]
+    want = (to_light @ n_map) / to_light[..., 2] * terminator_shadowing(n_map, to_light)
+    mirrored = (to_light @ (n_map * [-1, -1, 1])) / to_light[..., 2]
+    assert np.min(np.abs(want - mirrored)) > 0.1  # the test tells the tilt's sign
     print(f"{kind}: radiance ratio {ratio.mean():.5f} vs closed form {want.mean():.5f}, "
           f"max rel. error {np.max(np.abs(ratio / want - 1)):.2e}")
     np.testing.assert_allclose(ratio, want, rtol=TOL_RATIO)
