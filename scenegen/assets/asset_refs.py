@@ -10,6 +10,7 @@ file and line it was read from (``chair.mtl:7: map_Kd '../x.png' leaves the asse
 from __future__ import annotations
 
 import json
+import math
 import re
 import struct
 from dataclasses import dataclass
@@ -102,7 +103,7 @@ def _scan_obj(path: Path) -> AssetScan:
     for n, line in _lines(path):
         head, _, rest = line.partition(" ")
         if head == "mtllib":
-            for written in _mtllib_names(rest.strip(), path.parent):
+            for written in mtllib_names(rest.strip(), path.parent):
                 ref = checked_ref(written, path.parent, path, n, "mtllib")
                 refs.append(ref)
                 mtl_refs, mtl_names = scan_mtl(ref.path, path.parent)
@@ -113,7 +114,7 @@ def _scan_obj(path: Path) -> AssetScan:
     return AssetScan(tuple(refs), tuple(names), colors)
 
 
-def _mtllib_names(rest: str, folder: Path) -> list[str]:
+def mtllib_names(rest: str, folder: Path) -> list[str]:
     """The MTL names of an ``mtllib`` line: one name with spaces if that file exists, else the
     whitespace-separated names."""
     if " " in rest and (folder / rest).is_file():
@@ -121,14 +122,36 @@ def _mtllib_names(rest: str, folder: Path) -> list[str]:
     return rest.split()
 
 
+#: MTL statements read as numbers: how many (1 or 3 for a colour; 1 for a scalar) and the range.
+MTL_NUMBERS = {"kd": ((1, 3), 0.0, 1.0), "ks": ((1, 3), 0.0, 1.0), "ke": ((1, 3), 0.0, None),
+               "ns": ((1,), 0.0, None), "d": ((1,), 0.0, 1.0), "tr": ((1,), 0.0, 1.0)}
+
+
+def _check_numbers(key: str, args: list[str], mtl: Path, n: int) -> None:
+    counts, lo, hi = MTL_NUMBERS[key.lower()]
+    try:
+        vals = [float(a) for a in args[:max(counts)]]
+    except ValueError:
+        vals = None
+    bad = vals is None or len(vals) not in counts or not all(
+        math.isfinite(v) and v >= lo and (hi is None or v <= hi) for v in vals)
+    if bad:
+        rng = f"in [{lo:g}, {hi:g}]" if hi is not None else f">= {lo:g}"
+        raise AssetFileError(f"{key}: expected {' or '.join(map(str, counts))} number(s) {rng}, "
+                             f"got {' '.join(args) or 'nothing'!r}", mtl, n)
+
+
 def scan_mtl(mtl: Path, asset_dir: Path) -> tuple[list[AssetRef], list[str]]:
-    """(texture files named by an MTL file, checked; its material names in order)."""
+    """(texture files named by an MTL file, checked; its material names in order); the numbers
+    of Kd, Ks, Ke, Ns, d and Tr are checked too."""
     refs, names = [], []
     for n, line in _lines(mtl):
         parts = line.split()
         key = parts[0]
         if key == "newmtl":
             names.append(" ".join(parts[1:]))
+        elif key.lower() in MTL_NUMBERS:
+            _check_numbers(key, parts[1:], mtl, n)
         elif key.lower() in MTL_MAP_KEYS:
             if len(parts) < 2:
                 raise AssetFileError(f"{key}: expected a file name", mtl, n)

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from scenegen.assets.asset_refs import checked_ref
+from scenegen.assets.asset_refs import checked_ref, mtllib_names
 from scenegen.assets.shapes import uv_from_trimesh
 from scenegen.assets.textures import load_data_image, load_image
 from scenegen.geometry.color import linear_from_srgb
@@ -173,9 +173,7 @@ def _obj_materials(path: Path) -> dict[str, AssetMaterial]:
         for n, line in enumerate(fh, start=1):
             parts = line.split("#", 1)[0].split()
             if parts[:1] == ["mtllib"]:
-                rest = " ".join(parts[1:])
-                names = [rest] if (path.parent / rest).is_file() else parts[1:]
-                for written in names:
+                for written in mtllib_names(" ".join(parts[1:]), path.parent):
                     mtl = checked_ref(written, path.parent, path, n, "mtllib").path
                     out.update(parse_mtl(mtl, path.parent))
     return out

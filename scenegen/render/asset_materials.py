@@ -20,6 +20,7 @@ import numpy as np
 
 from scenegen.render.materials import bitmap, rgb, value_bitmap, with_alpha, with_bump_map, with_normal_map
 
+
 def _scaled(texture, factor) -> np.ndarray:
     return np.asarray(texture, np.float32) * np.asarray(factor, np.float32)[None, None, :]
 

@@ -13,9 +13,9 @@ import numpy as np
 import trimesh
 
 from scenegen.assets import meshes, shapes
+from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
-from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.render.arrays import to_jit
 from scenegen.render.asset_materials import asset_bsdf, asset_emitter
 from scenegen.render.materials import board_material, is_alpha_masked, material_dict

@@ -104,7 +104,7 @@ def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Materi
     kind = f.get("type").as_enum(mm.MATERIAL_TYPES, "material type")
     f.check(required=("type",), optional=TYPE_KEYS[kind] + MAP_KEYS)
     cls = CLASSES[kind]
-    common = dict(name=name, maps=parse_maps(f, node, ctx), where=node.where)
+    common = {"name": name, "maps": parse_maps(f, node, ctx), "where": node.where}
     if kind == "conductor":
         cname = field_info(cls, "material").default
         if "material" in f:

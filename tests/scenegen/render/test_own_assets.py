@@ -82,7 +82,7 @@ def render(folder, tag, mesh, extra="", capsys=None):
 
 def pixel(x, y):
     """(row, col) of the world point (x, y, 0) in the test camera (eye at z = 1.6, f = 60 px)."""
-    return int(round(31.5 - y * 60 / 1.6)), int(round(47.5 + x * 60 / 1.6))
+    return round(31.5 - y * 60 / 1.6), round(47.5 + x * 60 / 1.6)
 
 
 def texel_pixels(x0):
@@ -192,6 +192,9 @@ def test_the_files_an_obj_names_are_hashed(tmp_path):
     ("map_Kd ../outside.png", "leaves the asset's folder"),
     ("map_Kd /etc/passwd", "no absolute path"),
     ("map_Kd missing.png", "file not found"),
+    ("map_Kd http://example.com/t.png", "no absolute path or URL"),
+    ("Kd 0.5 red 0.1", "expected 1 or 3 number(s) in [0, 1]"),
+    ("d 1.5", "expected 1 number(s) in [0, 1]"),
 ])
 def test_bad_names_in_an_mtl_name_the_file_and_line(tmp_path, line, want):
     sub = tmp_path / "asset"
@@ -202,7 +205,7 @@ def test_bad_names_in_an_mtl_name_the_file_and_line(tmp_path, line, want):
     spec_path.write_text("name: b\nobjects:\n  - {name: m, mesh: asset/quad.obj}\n")
     with pytest.raises(SpecError) as e:
         load_spec(spec_path)
-    assert str(e.value).startswith(f"{sub / 'quad.mtl'}:5: map_Kd"), str(e.value)
+    assert str(e.value).startswith(f"{sub / 'quad.mtl'}:5: {line.split()[0]}"), str(e.value)
     assert want in str(e.value) and "objects[0].mesh" in str(e.value)
 
 
@@ -231,8 +234,9 @@ def test_gltf_normal_texture_is_the_spec_normal_map(tmp_path):
     write_glb(tmp_path, tex, metallicFactor=0.0, roughnessFactor=0.6, normalTexture=Image.fromarray(nmap))
     lights = "lights:\n  - {type: point, position: [-2, 3, 6], intensity: 40}\n"
     glb, ref = [], []
-    for tag, extra, out in (("gn", "", glb), ("gs", "    material: {type: principled, texture: {type: image, path: tex.png}, "
-                                                 "roughness: 0.6, normal_map: n.png}\n", ref)):
+    spec_mat = ("    material: {type: principled, texture: {type: image, path: tex.png}, "
+                "roughness: 0.6, normal_map: n.png}\n")
+    for tag, extra, out in (("gn", "", glb), ("gs", spec_mat, ref)):
         text = SCENE.format(tag=tag, mesh="quad.glb", extra=extra).replace(
             "lights:\n  - {type: constant, radiance: 1.0}\n", lights)
         (tmp_path / f"{tag}.yaml").write_text(text)
@@ -259,7 +263,7 @@ def test_gltf_alpha_mask_truth_follows_the_holes(tmp_path):
     m.export(tmp_path / "mask.glb")
     extra = ("  - name: back\n    shape: {type: plane, size: [4, 3]}\n"
              "    material: {type: diffuse, color: [0.05, 0.05, 0.8]}\n")
-    ds, img, truth = render(tmp_path, "mask", "mask.glb", extra)
+    _, img, truth = render(tmp_path, "mask", "mask.glb", extra)
     oid = truth["object_id"]
     assert set(np.unique(oid)) == {1, 2}
     # wherever a pixel's whole 3x3 neighbourhood sees one surface (texel edges do not fall on
@@ -286,3 +290,30 @@ def test_mtl_specular_and_emission(tmp_path, capsys):
                         "newmtl tex\nKd 0 0 0\nKe 0.3 0.6 0.9\n")
     _, img, _ = render(tmp_path, "emis", "quad.obj")
     np.testing.assert_allclose(img[pixel(0.5, 0)], [0.3, 0.6, 0.9], atol=1e-3)
+
+
+@pytest.mark.render
+def test_gltf_with_two_meshes_keeps_each_material(tmp_path):
+    """A glTF scene of two meshes (two materials, node transforms): each part its own colour, one
+    object id, and the dataset's world mesh is the whole flattened file."""
+    from scenegen.assets.shapes import load_mesh
+
+    def quad(x0, rgb):
+        m = trimesh.Trimesh(vertices=[[0, -0.5, 0], [1, -0.5, 0], [1, 0.5, 0], [0, 0.5, 0]],
+                            faces=[[0, 1, 2], [0, 2, 3]], process=False)
+        m.visual = trimesh.visual.TextureVisuals(
+            uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]),
+            material=trimesh.visual.material.PBRMaterial(baseColorFactor=[*rgb, 1.0], metallicFactor=0.0,
+                                                         roughnessFactor=0.7))
+        return m, trimesh.transformations.translation_matrix([x0, 0, 0])
+
+    scene = trimesh.Scene()
+    for name, (m, T) in (("left", quad(-1.0, (0.8, 0.2, 0.1))), ("right", quad(0.0, (0.1, 0.3, 0.8)))):
+        scene.add_geometry(m, node_name=name, geom_name=name, transform=T)
+    scene.export(tmp_path / "two.glb")
+    ds, img, truth = render(tmp_path, "two", "two.glb")
+    a, b = img[pixel(-0.5, 0)], img[pixel(0.5, 0)]
+    assert a[0] > 3 * a[2] and b[2] > 2 * b[0]  # red left, blue right
+    assert set(np.unique(truth["object_id"][truth["valid"]])) == {1}
+    stored = ds.mesh("q")
+    np.testing.assert_allclose(np.asarray(stored.vertices), load_mesh(tmp_path / "two.glb").vertices, atol=1e-6)
