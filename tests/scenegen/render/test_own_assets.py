@@ -317,3 +317,13 @@ def test_gltf_with_two_meshes_keeps_each_material(tmp_path):
     assert set(np.unique(truth["object_id"][truth["valid"]])) == {1}
     stored = ds.mesh("q")
     np.testing.assert_allclose(np.asarray(stored.vertices), load_mesh(tmp_path / "two.glb").vertices, atol=1e-6)
+
+
+def test_colour_variation_of_a_mesh_with_its_own_materials_is_refused(tmp_path):
+    write_texture(tmp_path)
+    write_obj(tmp_path)
+    spec_path = tmp_path / "v.yaml"
+    spec_path.write_text("name: v\nobjects:\n  - {name: m, mesh: quad.obj}\n"
+                         "variation:\n  objects:\n    m: {color: {min: [0.1, 0.1, 0.1], max: [0.9, 0.9, 0.9]}}\n")
+    with pytest.raises(SpecError, match="renders its mesh file's own materials"):
+        load_spec(spec_path)
