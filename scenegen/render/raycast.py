@@ -28,7 +28,7 @@ def first_hit_distance(scene, origin_world, directions_world, alpha_masked: bool
         return np.zeros(0), np.zeros((0, 3))
     if mi.variant().startswith("scalar"):  # the slow fallback without a working libLLVM
         if alpha_masked:
-            raise NotImplementedError("alpha-masked ray casts need a vectorised variant")
+            raise ValueError("alpha masks need a vectorised Mitsuba variant for their ray casts (llvm_ad_rgb / cuda_ad_rgb)")
         t = np.array([float(scene.ray_intersect_preliminary(mi.Ray3f(mi.Point3f(*map(float, o)),
                                                                      mi.Vector3f(*map(float, di)))).t)
                       for di in d], dtype=np.float64)

@@ -101,7 +101,7 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     """
     if mi.variant().startswith("scalar"):
         if alpha_masked:
-            raise NotImplementedError("alpha-masked truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
+            raise ValueError("alpha masks need a vectorised Mitsuba variant for their truth (llvm_ad_rgb / cuda_ad_rgb)")
         if row_poses is not None:
             raise NotImplementedError("rolling-shutter truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
         out = _truth_pass_scalar(scene, camera, cam_from_world, id_tables)

@@ -327,3 +327,25 @@ def test_colour_variation_of_a_mesh_with_its_own_materials_is_refused(tmp_path):
                          "variation:\n  objects:\n    m: {color: {min: [0.1, 0.1, 0.1], max: [0.9, 0.9, 0.9]}}\n")
     with pytest.raises(SpecError, match="renders its mesh file's own materials"):
         load_spec(spec_path)
+
+
+@pytest.mark.render
+def test_a_moving_mesh_with_its_own_materials_blurs_every_part(tmp_path):
+    """Object motion moves every part (one Mitsuba mesh per material): the render of the
+    two-material OBJ is blurred across the parts' border, and the truth (mid-exposure pose) is
+    that of the still object."""
+    write_texture(tmp_path)
+    write_obj(tmp_path)
+    motion = "    motion: {linear_velocity_mps: [20, 0, 0]}\n"
+    cams = SCENE.format(tag="mv", mesh="quad.obj", extra=motion).replace(
+        "cam: {model: pinhole,", "cam: {shutter: {exposure_s: 0.01}, model: pinhole,")
+    (tmp_path / "mv.yaml").write_text(cams.replace("render: {spp: 64, max_depth: 2}",
+                                                   "render: {spp: 16, max_depth: 2, motion_subframes: 4}"))
+    assert main(["render", str(tmp_path / "mv.yaml"), "-o", str(tmp_path / "mv"), "-q"]) == 0
+    _, still, still_truth = render(tmp_path, "still", "quad.obj")
+    ds = Dataset(tmp_path / "mv")
+    moved, truth = ds.linear_image(ds.views[0]), ds.truth(ds.views[0])
+    np.testing.assert_array_equal(truth["object_id"], still_truth["object_id"])
+    # 0.2 m of travel over the exposure (7.5 px): the plain/textured border is smeared
+    r, c = pixel(0.0, 0.25)
+    assert not np.allclose(moved[r, c - 3:c + 4], still[r, c - 3:c + 4], atol=0.05)
