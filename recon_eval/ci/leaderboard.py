@@ -15,16 +15,17 @@ from recon_eval.report.leaderboard_page import html_page, markdown
 from recon_eval.runners import method, run_method
 
 
-def run_leaderboard(datasets, methods, out_dir, *, log=print) -> dict:
+def run_leaderboard(datasets, methods, out_dir, *, log=print, declared: dict | None = None) -> dict:
+    """Every method (built-in, or one of the user's ``declared`` methods) on every dataset."""
     for m in methods:
-        method(m)  # unknown names fail before anything runs
+        method(m, declared)  # unknown names fail before anything runs
     out = Path(out_dir)
     runs, skipped = [], []
     for d in datasets:
         scene = read_dataset(d).scene_name
         for m in methods:
             try:
-                doc = run_method(m, d, out / scene / m)
+                doc = run_method(m, d, out / scene / m, declared=declared)
             except NotApplicable as exc:
                 skipped.append({"scene": scene, "method": m, "why": str(exc)})
                 continue

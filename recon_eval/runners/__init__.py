@@ -5,7 +5,9 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
-:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks); shared:
+:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
+(a user's own command line, declared in a methods file or with ``run --command``:
+:mod:`.declared`); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
 the production methods; :data:`FAULTS` the deliberately broken ones of :mod:`.faults`, which gates
 must catch, run by name the same way.
@@ -87,22 +89,25 @@ FAULTS: dict[str, Method] = {m.name: m for m in [
 ]}
 
 
-def method(name: str) -> Method:
-    """The registered method ``name``: a production method, else a fault; InputError otherwise."""
-    if name in METHODS:
-        return METHODS[name]
-    if name in FAULTS:
-        return FAULTS[name]
-    close = get_close_matches(name, list(METHODS) + list(FAULTS), n=1)
+def method(name: str, declared: dict | None = None) -> Method:
+    """The registered method ``name``: a production method, else a fault, else one of the user's
+    ``declared`` methods (:mod:`.declared`: external commands); InputError otherwise."""
+    declared = declared or {}
+    for table in (METHODS, FAULTS, declared):
+        if name in table:
+            return table[name]
+    close = get_close_matches(name, list(METHODS) + list(FAULTS) + list(declared), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}; faults: {', '.join(FAULTS)}")
+    mine = f"; declared: {', '.join(declared)}" if declared else ""
+    raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}; faults: {', '.join(FAULTS)}"
+                     f"{mine}")
 
 
-def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
-    """Run method ``name`` on the dataset folder ``dataset``; raw outputs and ``result.json`` go to
-    ``out_dir``. Returns the result document. Raises InputError (NotApplicable when the dataset
-    lacks what the method needs)."""
-    m = method(name)
+def run_method(name: str, dataset, out_dir, *, write: bool = True, declared: dict | None = None) -> dict:
+    """Run method ``name`` (built-in, fault or one of ``declared``) on the dataset folder
+    ``dataset``; raw outputs and ``result.json`` go to ``out_dir``. Returns the result document.
+    Raises InputError (NotApplicable when the dataset lacks what the method needs)."""
+    m = method(name, declared)
     ds = read_dataset(dataset)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

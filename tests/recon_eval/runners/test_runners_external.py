@@ -1,0 +1,234 @@
+"""External methods (recon_eval.runners.external, .declared): a user's command line run and
+scored like a built-in method. No-render tests for the command contract and failures; render
+tests run docs/ci.md's worked example verbatim on scenes/wide_baseline.yaml and show that an
+external F on the match sets gets exactly the built-in opencv-f-ransac numbers."""
+from __future__ import annotations
+
+import json
+import shlex
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from recon_eval.cli import main
+from recon_eval.errors import InputError
+from recon_eval.runners import external, run_method, stereo
+from recon_eval.runners.common import RunOutput
+from recon_eval.runners.declared import external_method, load_methods
+from scenegen.dataset.codecs import write_pfm
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def run(argv, capsys):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+# --- the command contract -----------------------------------------------------------------------
+@pytest.mark.parametrize("command, kind, expect", [
+    ("tool {images} {out}", "nope", "kind: expected one of fmatrix, disparity"),
+    ("tool {images} {oot}", "fmatrix", "unknown placeholder {oot} for kind 'fmatrix'"),
+    ("tool {images}", "fmatrix", "needs {out}"),
+    ("tool 'unclosed {out}", "fmatrix", "cannot split"),
+    ("tool {matches} {image1} {out}", "fmatrix", "use {matches} or the images, not both"),
+    ("tool {images} {out}", "disparity", "unknown placeholder {images} for kind 'disparity'"),
+])
+def test_bad_commands_are_refused_naming_the_declaration(command, kind, expect):
+    with pytest.raises(InputError) as e:
+        external.check_command(command, kind, "m.yaml:4")
+    assert str(e.value).startswith("m.yaml:4: ") and expect in str(e.value)
+
+
+def test_substitution_is_per_argument_without_a_shell(tmp_path):
+    argv = external.check_command("t --a={image1} {images} '$(rm -rf x); echo' {out}", "fmatrix", "x")
+    got = external.substitute(argv, {"image1": "/d/a b.png", "images": ["/d/a b.png", "/d/c.png"], "out": "/o/F.txt"})
+    assert got == ["t", "--a=/d/a b.png", "/d/a b.png", "/d/c.png", "$(rm -rf x); echo", "/o/F.txt"]
+    with pytest.raises(InputError, match="must be an argument of its own"):
+        external.substitute(["x{images}"], {"images": ["a", "b"]})
+
+
+def _script(tmp_path, body: str) -> str:
+    f = tmp_path / "tool.py"
+    f.write_text("import sys, pathlib, time\n" + body)
+    return f"{{python}} {shlex.quote(str(f))}"
+
+
+def test_argv_reaches_the_program_verbatim(tmp_path):
+    cmd = _script(tmp_path, "pathlib.Path(sys.argv[-1]).write_text(repr(sys.argv[1:-1]))\n") + " '$(x);|' {view1} {out}"
+    out = RunOutput()
+    why = external.invoke({"command": cmd, "kind": "fmatrix", "name": "m"},
+                          {"view1": "v a", "out": str(tmp_path / "o.txt")}, tmp_path / "log", "p", out)
+    assert why is None and (tmp_path / "o.txt").read_text() == repr(["$(x);|", "v a"])
+
+
+def test_failures_are_recorded_with_stderr_not_raised(tmp_path, capsys):
+    cmd = _script(tmp_path, "print('line one', file=sys.stderr); print('it broke', file=sys.stderr); sys.exit(3)\n")
+    out = RunOutput()
+    why = external.invoke({"command": cmd + " {out}", "kind": "fmatrix", "name": "m"}, {"out": "x"},
+                          tmp_path / "log", "a__b", out)
+    assert why == "exit status 3" and out.notes["a__b"]["stderr_tail"] == ["line one", "it broke"]
+    assert (tmp_path / "log" / "stderr.txt").read_text() == "line one\nit broke\n"
+    assert "m: a__b: exit status 3: it broke" in capsys.readouterr().err
+    slow = _script(tmp_path, "time.sleep(30)\n") + " {out}"
+    why = external.invoke({"command": slow, "kind": "fmatrix", "name": "m", "timeout_s": 0.5}, {"out": "x"},
+                          tmp_path / "log2", "a__b", out)
+    assert why == "timed out after 0.5 s"
+    with pytest.raises(InputError, match="cannot run 'no-such-program-xyz'"):
+        external.invoke({"command": "no-such-program-xyz {out}", "kind": "fmatrix", "name": "m"}, {"out": "x"},
+                        tmp_path / "log3", "a__b", out)
+
+
+def test_methods_file_errors_name_file_and_line(tmp_path):
+    f = tmp_path / "m.yaml"
+    cases = {
+        "version: 1\nmethods:\n  - {name: a, kind: fmatrix, command: 't {images} {out}', kind: disparity}\n":
+            "m.yaml:3: methods[0].kind: duplicate key",
+        "version: 1\nmethods:\n  - {name: a, kind: flux, command: 't {out}'}\n": "m.yaml:3: methods[0].kind",
+        "version: 1\nmethods:\n  - {name: opencv-f-ransac, kind: fmatrix, command: 't {images} {out}'}\n":
+            "is a built-in method",
+        "version: 1\nmethods:\n  - {name: a, kind: fmatrix, command: 't {images}'}\n": "m.yaml:3: methods[0]: command: needs {out}",
+        "version: 1\nmethods:\n  - {name: ../x, kind: fmatrix, command: 't {images} {out}'}\n": "m.yaml:3: methods[0]: name: '../x'",
+        "version: 1\nmethods:\n  - {name: a, kind: fmatrix, command: 't {images} {out}', timeout_s: -1}\n":
+            "m.yaml:3: methods[0].timeout_s",
+        "version: 1\nmethods:\n  - {name: a, kind: fmatrix, command: 't {images} {out}'}\n"
+        "  - {name: a, kind: fmatrix, command: 't {images} {out}'}\n": "m.yaml:4: methods[1]: name: 'a' is declared twice",
+    }
+    for text, expect in cases.items():
+        f.write_text(text)
+        with pytest.raises(InputError) as e:
+            load_methods(f)
+        assert expect in str(e.value), (text, str(e.value))
+    assert set(load_methods(ROOT / "examples" / "methods.yaml")) == {"my-fmatrix", "my-fmatrix-transposed",
+                                                                     "my-fmatrix-matches"}
+
+
+def test_cli_usage_errors(plane_dataset, tmp_path, capsys):
+    root = plane_dataset[0]
+    code, _, err = run(["run", "--command", "t {images} {out}", root, "-o", tmp_path], capsys)
+    assert code == 2 and "--command needs --kind" in err
+    code, _, err = run(["run", "opencv-f-ransac", root, "-o", tmp_path, "--kind", "fmatrix"], capsys)
+    assert code == 2 and "--kind and --pixels go with --command" in err
+    code, _, err = run(["run", "--command", "t {images} {out}", "--kind", "fmatrix", "--name", "opencv-f-8point",
+                        root, "-o", tmp_path], capsys)
+    assert code == 2 and "is a built-in method" in err
+
+
+# --- disparity kind: the built-in stereo scoring, with a stand-in dataset --------------------------
+class _Frame:
+    """One rectified frame on disk: a random texture, truth disparity SHIFT everywhere."""
+
+    SHIFT = 6.0
+
+    def __init__(self, root: Path):
+        self.root = root
+        rng = np.random.default_rng(1)
+        self.images = [rng.integers(0, 256, (24, 32), dtype=np.uint8) for _ in range(2)]
+        for side, im in zip(("left", "right"), self.images):
+            cv2.imwrite(str(root / f"{side}.png"), im)
+        self.disp = np.full((24, 32), self.SHIFT)
+
+    def stereo_left_views(self):
+        return ("cam_l",)
+
+    def stereo_images(self, left):
+        return tuple(self.images)
+
+    def stereo_image_path(self, left, side):
+        return self.root / f"{side}.png"
+
+    def stereo_disparity(self, left):
+        return self.disp
+
+    def stereo_noc_mask(self, left):
+        return np.ones(self.disp.shape, bool)
+
+
+def test_external_disparity_is_scored_as_the_builtin(tmp_path):
+    """The command writes the truth with 10 pixels 3 px off: Middlebury bad-2.0 is exactly 10 / 768."""
+    frame = _Frame(tmp_path)
+    d = frame.disp.copy()
+    d[0, :10] += 3.0
+    np.save(tmp_path / "answer.npy", d)
+    tool = tmp_path / "tool.py"
+    tool.write_text("import sys, numpy as np\nfrom scenegen.dataset.codecs import write_pfm\n"
+                    f"assert sys.argv[1].endswith('left.png') and sys.argv[2].endswith('right.png')\n"
+                    f"write_pfm(sys.argv[3], np.load({str(tmp_path / 'answer.npy')!r}))\n")
+    m = external_method("my-stereo", "disparity", f"{{python}} {tool} {{left}} {{right}} {{out}}")
+    res = external.disparity(frame, tmp_path / "run", dict(m.options))
+    assert res.metrics["bad_2_0_noc_pct"] == pytest.approx(100 * 10 / 768, abs=1e-12)
+    assert res.raw_files == ["disparity/cam_l.pfm"]
+    write_pfm(tmp_path / "same.pfm", d)
+    ref = stereo.run(frame, tmp_path / "ref", {}, compute=lambda ds, left, path, out: path.write_bytes(
+        (tmp_path / "same.pfm").read_bytes()))
+    assert ref.metrics == res.metrics
+    bad = external_method("bad-stereo", "disparity", "{python} -c 'import sys; sys.exit(1)' {left} {out}")
+    res = external.disparity(frame, tmp_path / "run2", dict(bad.options))
+    assert res.notes["cam_l"]["failed"] == "exit status 1" and res.metrics["invalid_noc_pct"] == 100.0
+
+
+# --- on a rendered scene ----------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def wide(tmp_path_factory):
+    from scenegen.pipeline.run import render_spec
+
+    root = tmp_path_factory.mktemp("wide") / "wide"
+    render_spec(ROOT / "scenes" / "wide_baseline.yaml", root, progress=False)
+    return root
+
+
+def _worked_example():
+    text = (ROOT / "docs" / "ci.md").read_text()
+    block = text.split("<!-- worked-example:start -->", 1)[1].split("<!-- worked-example:end -->", 1)[0]
+    lines = [ln for ln in block.splitlines() if ln.startswith(("scenegen ", "recon-eval "))]
+    assert lines[0] == "scenegen render scenes/wide_baseline.yaml -o out/wide"
+    return lines[1:]
+
+
+@pytest.mark.render
+def test_docs_worked_example_runs_as_written(wide, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(ROOT)  # the methods file names examples/my_fmatrix.py from the repository root
+    for line in _worked_example():
+        cmd, _, comment = line.partition("#")
+        expect = int(comment.split("exit")[1]) if "exit" in comment else 0
+        argv = [str(wide) if t == "out/wide" else str(tmp_path / t) if t.startswith(("runs/", "board")) else t
+                for t in shlex.split(cmd)[1:]]
+        code, out, err = run(argv, capsys)
+        assert code == expect, (line, out, err)
+        if argv[0] == "gate" and expect == 0:
+            assert "2 of 2 gates hold" in out
+        if argv[0] == "gate" and expect == 1:
+            assert "FAIL sampson_rms_px" in out and "my-fmatrix-transposed" in out
+    mine = json.loads((tmp_path / "runs/my-fmatrix/result.json").read_text())
+    assert mine["command"] == "run" and mine["inputs"]["method"] == "my-fmatrix"
+    assert mine["inputs"]["scene"] == "wide_baseline"
+    assert mine["inputs"]["raw_files"] == ["pair_0000__pair_0001/F.txt"]
+    m = mine["metrics"]
+    assert m["sampson_rms_px"] == pytest.approx(1.098, abs=5e-3) and m["pose_err_deg"] == pytest.approx(10.4, abs=0.05)
+    assert json.loads((tmp_path / "runs/my-f/result.json").read_text())["metrics"] == m  # --command: same numbers
+    board = json.loads((tmp_path / "board/leaderboard.json").read_text())
+    assert [r["inputs"]["method"] for r in board["runs"]] == ["my-fmatrix", "my-fmatrix-matches", "opencv-f-ransac"]
+    # a broken threshold fails the gate (exit 1) and names the gate's file:line
+    g = tmp_path / "broken.yaml"
+    g.write_text((ROOT / "examples" / "gates_my_fmatrix.yaml").read_text().replace("threshold: 2.0", "threshold: 0.5"))
+    code, out, _ = run(["gate", g, tmp_path / "board/leaderboard.json", "--junit", tmp_path / "j.xml"], capsys)
+    assert code == 1 and f"FAIL sampson_rms_px = {m['sampson_rms_px']:.6g}, threshold <= 0.5" in out and f"{g}:5" in out
+
+
+@pytest.mark.render
+def test_external_f_on_match_sets_equals_the_builtin(wide, tmp_path):
+    """The same cv2 call as opencv-f-ransac, as a user's script on {matches}: identical result groups."""
+    tool = tmp_path / "ransac.py"
+    tool.write_text("import sys, cv2, numpy as np\nm = np.load(sys.argv[1])\n"
+                    "F, mask = cv2.findFundamentalMat(m[:, :2], m[:, 2:], cv2.FM_RANSAC, 3.0, 0.999, 10000)\n"
+                    "np.savetxt(sys.argv[2], F)\nnp.save(sys.argv[3], mask.ravel() != 0)\n")
+    (tmp_path / "m.yaml").write_text(f"version: 1\nmethods:\n  - {{name: my-ransac, kind: fmatrix, command: "
+                                     f"'{{python}} {tool} {{matches}} {{out}} {{inliers}}'}}\n")
+    mine = run_method("my-ransac", wide, tmp_path / "mine", declared=load_methods(tmp_path / "m.yaml"))
+    ref = run_method("opencv-f-ransac", wide, tmp_path / "ref")
+    assert mine["metrics"] == ref["metrics"] and mine["results"] == ref["results"]
+    assert mine["inputs"]["method"] == "my-ransac" and mine["inputs"]["options"]["kind"] == "fmatrix"
+    assert (tmp_path / "mine" / "pair_0000__pair_0001" / "synthetic" / "matches.npy").is_file()
