@@ -87,7 +87,7 @@ def score_fmatrix(a):
         size = tuple(a.size) if a.size else None
         eye = np.full((3, 3), np.nan)
         truth = PairTruth(m[:, :2], m[:, 2:], F_gt, eye, eye, eye, np.full(3, np.nan), size, size, "as given", {})
-        labels = read_mask(a.labels) if a.labels else None
+        labels = read_mask(a.labels, len(m)) if a.labels else None  # one label per row of --matches
     inliers = None
     if a.inliers:
         if labels is None:

@@ -232,3 +232,16 @@ def test_external_f_on_match_sets_equals_the_builtin(wide, tmp_path):
     assert mine["metrics"] == ref["metrics"] and mine["results"] == ref["results"]
     assert mine["inputs"]["method"] == "my-ransac" and mine["inputs"]["options"]["kind"] == "fmatrix"
     assert (tmp_path / "mine" / "pair_0000__pair_0001" / "synthetic" / "matches.npy").is_file()
+
+
+@pytest.mark.render
+def test_truth_F_is_the_stored_crossview_F(wide):
+    from recon_eval.readers.scenegen_dataset import read_dataset
+    from scenegen.geometry.twoview import fundamental
+
+    ds = read_dataset(wide)
+    F, source = ds.truth_fundamental("pair_0000", "pair_0001")
+    assert source == "crossview/twoview/pair_0000/pair_0001.json"
+    (c1, p1), (c2, p2) = ds.camera("pair_0000"), ds.camera("pair_0001")
+    G = fundamental(c1.K, c2.K, p2 @ p1.inverse())
+    assert np.allclose(F / np.linalg.norm(F), G / np.linalg.norm(G) * np.sign(np.sum(F * G)), atol=1e-12)
