@@ -86,13 +86,21 @@ def leaderboard_arguments(p) -> None:
     p.add_argument("--methods", nargs="+", required=True, help="method names (built-in or of --methods-file)")
     p.add_argument("-o", "--out", required=True, help="output folder")
     _declared_arguments(p)
+    p.add_argument("--gates", metavar="GATES.yaml", help="check the runs against a gate file: the outcomes are "
+                                                         "printed and coloured in leaderboard.html; exit 1 if one fails")
 
 
 def leaderboard(a) -> int:
+    gates = load_gates(a.gates) if a.gates else None  # a bad gate file fails before anything runs
     doc = run_leaderboard(a.datasets, a.methods, a.out, declared=_declared(a))
-    for p in write_all(doc, a.out):
+    outcomes = []
+    if gates:
+        outcomes = evaluate(gates, [(f"leaderboard.json#runs[{k}]", r) for k, r in enumerate(doc["runs"])])
+        for o in outcomes:
+            print(o.message)
+    for p in write_all(doc, a.out, outcomes):
         print(f"wrote {p}")
-    return 0
+    return EXIT_GATE_FAILED if any(not o.passed for o in outcomes) else 0
 
 
 def gate_arguments(p) -> None:

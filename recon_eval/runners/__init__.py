@@ -13,7 +13,8 @@ the production methods; :data:`FAULTS` the deliberately broken ones of :mod:`.fa
 must catch, run by name the same way.
 
 :func:`run_method` runs one registered method and writes ``OUT/result.json`` (the run-result
-JSON, ``command: "run"``, docs/ci.md) next to the raw outputs.
+JSON, ``command: "run"``, docs/ci.md) and ``OUT/report.html`` (its summary and every scalar)
+next to the raw outputs.
 """
 from __future__ import annotations
 
@@ -27,6 +28,7 @@ import cv2
 from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report.document import document, to_jsonable, write_json_atomic
+from recon_eval.report.html import render_html, write_html_atomic
 from recon_eval.runners.common import RUN_SCHEMA_VERSION, RunOutput, Timer
 
 
@@ -39,6 +41,23 @@ class Method:
     options: tuple = ()  # (key, value) pairs passed to the function
     fault: bool = False  # a deliberately broken estimator (FAULTS)
 
+    @property
+    def task(self) -> str:
+        """What the method estimates (the leaderboard page's table): :data:`TASKS`, else its module."""
+        return TASKS.get((self.module, self.function), TASKS.get((self.module, None), self.module))
+
+
+#: The task of each runner function ((module, function); (module, None): every function of the
+#: module): methods of one task share a leaderboard table, one column per metric.
+TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo disparity",
+         ("twoview", "fundamental"): "fundamental matrix", ("twoview", "essential"): "essential matrix",
+         ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
+         ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
+         ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
+         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks",
+         ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
+         ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity"}
+
 
 def _m(name, module, function, description, **options):
     return Method(name, module, function, description, tuple(sorted(options.items())))
@@ -46,6 +65,9 @@ def _m(name, module, function, description, **options):
 
 _F = ("7point", "8point", "ransac", "lmeds", "usac_default", "usac_parallel", "usac_fm_8pts", "usac_fast",
       "usac_accurate", "usac_prosac", "usac_magsac")
+
+#: The HTML report of a run, beside its result.json.
+REPORT = "report.html"
 
 METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-calib-checkerboard", "calibration", "checkerboard",
@@ -114,7 +136,7 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True, declared: dic
     fn = getattr(importlib.import_module(f"recon_eval.runners.{m.module}"), m.function)
     with Timer() as t:
         res: RunOutput = fn(ds, out, dict(m.options))
-    inputs = {"method": m.name, "description": m.description, "options": dict(m.options),
+    inputs = {"method": m.name, "task": m.task, "description": m.description, "options": dict(m.options),
               "dataset": str(dataset), "scene": ds.scene_name, "raw_files": res.raw_files,
               "notes": res.notes, "seconds": t.s, "opencv_version": cv2.__version__,
               "run_schema_version": RUN_SCHEMA_VERSION}
@@ -122,6 +144,7 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True, declared: dic
     doc["metrics"] = to_jsonable(res.metrics)
     if write:
         write_json_atomic(out / "result.json", doc)
+        write_html_atomic(out / REPORT, render_html("run", inputs, res.results, [], metrics=res.metrics))
     return doc
 
 

@@ -103,7 +103,7 @@ def test_methods_file_errors_name_file_and_line(tmp_path):
             load_methods(f)
         assert expect in str(e.value), (text, str(e.value))
     assert set(load_methods(ROOT / "examples" / "methods.yaml")) == {"my-fmatrix", "my-fmatrix-transposed",
-                                                                     "my-fmatrix-matches"}
+                                                                     "my-f-matches"}
 
 
 def test_cli_usage_errors(plane_dataset, tmp_path, capsys):
@@ -210,7 +210,12 @@ def test_docs_worked_example_runs_as_written(wide, tmp_path, monkeypatch, capsys
     assert m["sampson_rms_px"] == pytest.approx(1.098, abs=5e-3) and m["pose_err_deg"] == pytest.approx(10.4, abs=0.05)
     assert json.loads((tmp_path / "runs/my-f/result.json").read_text())["metrics"] == m  # --command: same numbers
     board = json.loads((tmp_path / "board/leaderboard.json").read_text())
-    assert [r["inputs"]["method"] for r in board["runs"]] == ["my-fmatrix", "my-fmatrix-matches", "opencv-f-ransac"]
+    assert [r["inputs"]["method"] for r in board["runs"]] == ["my-fmatrix", "my-f-matches", "opencv-f-ransac"]
+    assert {r["inputs"]["task"] for r in board["runs"]} == {"fundamental matrix"}  # one table on the page
+    page = (tmp_path / "board/leaderboard.html").read_text()
+    assert page.count("<h2>fundamental matrix</h2>") == 1 and 'href="wide_baseline/my-fmatrix/report.html"' in page
+    report = (tmp_path / "board/wide_baseline/my-fmatrix/report.html").read_text()
+    assert "<h2>Summary</h2>" in report and "sampson_rms_px" in report
     # a broken threshold fails the gate (exit 1) and names the gate's file:line
     g = tmp_path / "broken.yaml"
     g.write_text((ROOT / "examples" / "gates_my_fmatrix.yaml").read_text().replace("threshold: 2.0", "threshold: 0.5"))
