@@ -47,8 +47,9 @@ def summary_html(doc: dict, outcomes=()) -> str:
     n_pass = sum(r.status == "pass" for r in rows)
     n_ok = sum(r.status == "ok" for r in rows)
     verdict = "fail" if n_fail else "pass"
-    text = ((f"{n_fail} failed" if n_fail else "nothing failed") + f", {n_pass} gates passed, {n_ok} estimates ok, "
-            f"{len(rows)} items")
+    gates = sum(r.name.startswith("gate ") for r in rows)
+    text = ((f"{n_fail} failed" if n_fail else "nothing failed") + (f", {n_pass} of {gates} gates passed" if gates else "")
+            + f", {n_ok} estimates produced, {len(rows)} items")
     parts = [f'<h2>Summary</h2><p class="verdict {verdict}">{esc(text)}</p>',
              "<table><tr><th>status</th><th>item</th><th>value</th><th>note</th></tr>"]
     for r in rows:

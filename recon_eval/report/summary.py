@@ -18,9 +18,11 @@ from dataclasses import dataclass
 #: Fields shown per result group in a scoring command's summary (the full table follows it).
 FIELDS_PER_GROUP = 4
 
-#: (pattern on the metric's last path part, True if higher is better), first match wins; a metric
-#: matching none has no best value.
+#: (pattern on the metric's last path part, True if higher is better, None if neither), first match
+#: wins; a metric matching none has no best value either. A signed error (a bias) is best at 0,
+#: which no direction says: its absolute value is the ranked column.
 DIRECTIONS = (
+    (re.compile(r"^(?!abs_).*signed"), None),
     (re.compile(r"failure|invalid|outlier"), False),
     (re.compile(r"recall|precision|ratio|mma|repeatab|matching_score|accuracy|auc|fscore|f_score|^f1$|"
                 r"completeness|^n_|^a[123]$|registered|inlier"), True),

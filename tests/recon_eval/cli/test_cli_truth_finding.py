@@ -191,3 +191,20 @@ def test_disparity_view_uses_the_rectified_truth(stereo_rig, tmp_path, capsys):
     assert doc["results"]["middlebury"]["bad_2_0_pct"] == pytest.approx(100 * 10 / len(ok), abs=1e-12)
     code, _, err = run(["disparity", tmp_path / "d.pfm", stereo_rig, "--view", left, "--truth", "view"], capsys)
     assert code == 2 and "two identical pinhole cameras" in err
+
+
+@pytest.mark.render
+def test_disparity_command_agrees_with_the_stereo_run(stereo_rig, tmp_path, capsys):
+    """The SGBM run's own PFM scored by `disparity --view` (the rectified truth, found from the view
+    name alone) gives the run's non-occluded bad-2.0 and avgerr."""
+    from recon_eval.runners import run_method
+
+    doc = run_method("opencv-stereo-sgbm", stereo_rig, tmp_path / "run")
+    (pfm,) = doc["inputs"]["raw_files"]
+    left = pfm.removeprefix("disparity/").removesuffix(".pfm")
+    code, _, err = run(["disparity", tmp_path / "run" / pfm, stereo_rig, "--view", left, "--benchmark", "middlebury",
+                        "--json", tmp_path / "r.json", "--quiet"], capsys)
+    assert code == 0, err
+    mb = json.loads((tmp_path / "r.json").read_text())["results"]["middlebury"]
+    assert mb["bad_2_0_pct"] == pytest.approx(doc["metrics"]["bad_2_0_noc_pct"], abs=1e-12)
+    assert mb["avgerr_px"] == pytest.approx(doc["metrics"]["avgerr_noc_px"], abs=1e-12)

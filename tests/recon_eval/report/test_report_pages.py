@@ -94,7 +94,8 @@ def test_summary_of_a_run_lists_failed_invocations():
     ("max_rot_err_deg", False), ("mma_3", True), ("tilt.repeatability", True), ("matching_score", True),
     ("n_points3d", True), ("cloud_precision_at_1cm", True), ("fx_rel_err", False), ("synthetic.floor.mace_px", False),
     ("views_used_ratio", True), ("abs_median_signed_err_px", False), ("sigma1.median_rel_err", False),
-    ("localisation_err_px", False), ("calib_rms_px", False), ("median_signed_err_px", False),
+    ("localisation_err_px", False), ("calib_rms_px", False), ("median_signed_err_px", None),
+    ("description", None),
 ])
 def test_direction_of_the_leaderboard_metrics(metric, higher):
     assert higher_is_better(metric) is higher
