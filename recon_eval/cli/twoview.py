@@ -30,7 +30,7 @@ def fmatrix_arguments(p) -> None:
                    help="the two dataset views (F maps 1 -> 2); their truth correspondences need the pair in the "
                         "spec's crossview.pairs")
     p.add_argument("--pixels", choices=PIXELS, default="undistorted",
-                   help="dataset truth: the pixels F is for: undistorted (default; F exists only there: the "
+                   help="dataset truth: the pixels F (and --matches rows) are for: undistorted (default; F exists only there: the "
                         "dataset's truth F, Zhang distance and pose via K) or distorted (the raw pixels of the "
                         "stored images; no truth F for cameras with distortion). Same for pinhole cameras")
     p.add_argument("--match-set", choices=list(MATCH_KINDS),
@@ -63,7 +63,7 @@ def score_fmatrix(a):
             raise InputError("--labels is for a truth without a dataset; with --dataset give --match-set KIND")
         ds = read_dataset(a.dataset)
         v1, v2 = a.views
-        truth = pair_truth(ds, v1, v2, pixels=a.pixels, max_points=a.max_matches)
+        truth = pair_truth(ds, v1, v2, pixels=a.pixels, max_points=a.max_matches, correspondences=not a.matches)
         if a.matches:  # the user's own truth correspondences replace the dataset's
             m = read_npy(a.matches, (None, 4))
             truth = replace(truth, x1=m[:, :2], x2=m[:, 2:], notes={**truth.notes, "correspondences": a.matches})

@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from recon_eval.errors import InputError
+from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.matrix import read_matrix3
 from recon_eval.readers.npy import read_mask
 from recon_eval.readers.pfm import read_pfm
@@ -196,6 +196,8 @@ def fmatrix(ds, out_dir, options) -> RunOutput:
         if "zhang_f_distance" in res:
             out.metrics[pre + "f_distance_px"] = res["zhang_f_distance"].f_distance_px
         out.notes[f"{key}.truth"] = truth.notes
+    if not out.results:
+        raise NotApplicable(f"{ds.root}: the cross-view pairs are all zero-baseline: no fundamental matrix to estimate")
     return out
 
 

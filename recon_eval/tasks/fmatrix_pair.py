@@ -52,9 +52,11 @@ class PairTruth:
     notes: dict
 
 
-def pair_truth(ds, view1: str, view2: str, *, pixels: str, max_points: int = 20000) -> PairTruth:
+def pair_truth(ds, view1: str, view2: str, *, pixels: str, max_points: int = 20000,
+               correspondences: bool = True) -> PairTruth:
     """The :class:`PairTruth` of ``view1 -> view2`` of the dataset ``ds`` (a
-    :class:`recon_eval.readers.scenegen_dataset.DatasetTruth`), in ``pixels`` (:data:`PIXELS`)."""
+    :class:`recon_eval.readers.scenegen_dataset.DatasetTruth`), in ``pixels`` (:data:`PIXELS`);
+    without ``correspondences`` (the caller has its own) x1 and x2 are empty (0, 2)."""
     if pixels not in PIXELS:
         raise InputError(f"pixels: expected one of {', '.join(PIXELS)}, got {pixels!r}")
     (c1, p1), (c2, p2) = ds.camera(view1), ds.camera(view2)
@@ -62,9 +64,12 @@ def pair_truth(ds, view1: str, view2: str, *, pixels: str, max_points: int = 200
     F_und, source = ds.truth_fundamental(view1, view2)
     if F_und is None:
         raise InputError(f"{ds.root}: views {view1!r} and {view2!r} share one camera centre: no fundamental matrix")
-    x1, x2 = ds.correspondences(view1, view2, max_points=max_points)
-    if len(x1) == 0:
-        raise InputError(f"{ds.root}: views {view1!r} and {view2!r} share no visible truth point")
+    if correspondences:
+        x1, x2 = ds.correspondences(view1, view2, max_points=max_points)
+        if len(x1) == 0:
+            raise InputError(f"{ds.root}: views {view1!r} and {view2!r} share no visible truth point")
+    else:
+        x1 = x2 = np.zeros((0, 2))
     distorted_cams = not (c1.model == "pinhole" and c2.model == "pinhole")
     notes = {"pixels": pixels, "cameras": f"{c1.model} / {c2.model}",
              "correspondences": f"dataset truth correspondences ({len(x1)} visible, seeded sample)"}

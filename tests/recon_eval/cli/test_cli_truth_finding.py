@@ -99,6 +99,24 @@ class TestFmatrixDistortedPair:
         assert res[0] == res[1]
 
 
+def test_own_matches_need_no_correspondence_truth(plane_dataset, write_plane, tmp_path, capsys):
+    """--matches with --dataset: the dataset gives F, K and pose; its correspondence files are not needed."""
+    root, cams = plane_dataset
+    bare = tmp_path / "bare"
+    write_plane(bare, corr_pairs=[])
+    x1, x2 = read_dataset(root).correspondences("left_000", "right_000")
+    np.save(tmp_path / "m.npy", np.c_[x1, x2])
+    (c1, p1), (c2, p2) = cams["left_000"], cams["right_000"]
+    np.savetxt(tmp_path / "F.txt", fundamental(c1.K, c2.K, p2 @ p1.inverse()))
+    code, _, err = run(["fmatrix", tmp_path / "F.txt", "--dataset", bare, "--views", "left_000", "right_000",
+                        "--matches", tmp_path / "m.npy", "--json", tmp_path / "r.json", "--quiet"], capsys)
+    assert code == 0, err
+    r = json.loads((tmp_path / "r.json").read_text())["results"]
+    assert r["fundamental"]["n_points"] == len(x1) and r["fundamental"]["sampson_rms_px"] < 1e-4
+    code, _, err = run(["fmatrix", tmp_path / "F.txt", "--dataset", bare, "--views", "left_000", "right_000"], capsys)
+    assert code == 2 and "no correspondence truth" in err
+
+
 class TestInlierMask:
     def test_precision_recall_of_a_mask_against_labels(self, tmp_path, capsys):
         rng = np.random.default_rng(0)
