@@ -56,7 +56,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
          ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
-         ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity"}
+         ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
+         ("external", "sfm"): "structure from motion"}
 
 
 def _m(name, module, function, description, **options):

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -41,7 +42,7 @@ from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.matrix import read_matrix3
 from recon_eval.readers.npy import read_mask
 from recon_eval.readers.pfm import read_pfm
-from recon_eval.runners import stereo, twoview
+from recon_eval.runners import colmap, stereo, twoview
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
 from scenegen.dataset.layout import check_view_name
@@ -72,6 +73,9 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("disparity", "disparity", ("left", "right", "view1", "out"),
          "per rectified stereo frame: read {left} {right} (PNG), write the left disparity (PFM, px; inf/nan = none) "
          "to {out}; scored as the built-in stereo methods"),
+    Kind("sfm", "sfm", ("images", "out"),
+         "once: {images} is a folder of <view>.png, write a COLMAP model (cameras, images, points3D; .bin or .txt; "
+         "image names <view>.png) into the folder {out}; scored as pycolmap-incremental"),
 ]}
 ALWAYS = ("python", "dataset")
 
@@ -251,3 +255,30 @@ def disparity(ds, out_dir, options) -> RunOutput:
             path.unlink(missing_ok=True)
 
     return stereo.run(ds, out_dir, options, compute=compute)
+
+
+def sfm(ds, out_dir, options) -> RunOutput:
+    """The ``sfm`` kind (:data:`KINDS`): the built-in SfM scoring of the model the command wrote."""
+    if len(ds.views) < 3:
+        raise NotApplicable(f"{ds.root}: SfM needs at least 3 views, the dataset has {len(ds.views)}")
+    images, model = out_path(out_dir, "images/x").parent, Path(out_dir) / "model"
+    shutil.rmtree(images, ignore_errors=True)
+    shutil.rmtree(model, ignore_errors=True)
+    images.mkdir(parents=True)
+    model.mkdir()
+    for v in ds.views:
+        shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+    out = RunOutput()
+    why = invoke(options, {"images": str(images.resolve()), "out": str(model.resolve()),
+                           "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs", "sfm", out)
+    shutil.rmtree(images, ignore_errors=True)  # the copies of the images
+    files = sorted(str(f.relative_to(out_dir)) for f in model.iterdir() if f.is_file())
+    if why is None:
+        try:
+            colmap.score_model(ds, model, out)
+            out.raw_files += files
+            return out
+        except InputError as exc:  # an unreadable model is the method's failure, not bad input
+            _failed_output(out, "sfm", str(exc))
+    out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
+    return out

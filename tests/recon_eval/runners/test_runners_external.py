@@ -250,3 +250,44 @@ def test_truth_F_is_the_stored_crossview_F(wide):
     (c1, p1), (c2, p2) = ds.camera("pair_0000"), ds.camera("pair_0001")
     G = fundamental(c1.K, c2.K, p2 @ p1.inverse())
     assert np.allclose(F / np.linalg.norm(F), G / np.linalg.norm(G) * np.sign(np.sum(F * G)), atol=1e-12)
+
+
+# --- sfm kind: a COLMAP model written by the command, scored as pycolmap-incremental -------------
+def _colmap_text_model(d: Path, cams: dict, views, points) -> None:
+    from scipy.spatial.transform import Rotation
+
+    d.mkdir(parents=True)
+    (d / "cameras.txt").write_text("1 PINHOLE 40 30 40 40 19.5 14.5\n")
+    lines = []
+    for k, v in enumerate(views, start=1):
+        pose = cams[v][1]
+        x, y, z, w = Rotation.from_matrix(pose.R).as_quat()
+        lines += [f"{k} " + " ".join(repr(float(c)) for c in (w, x, y, z, *pose.t)) + f" 1 {v}.png", ""]
+    (d / "images.txt").write_text("\n".join(lines) + "\n")
+    (d / "points3D.txt").write_text("".join(f"{k} {p[0]!r} {p[1]!r} {p[2]!r} 0 0 0 0.5\n"
+                                            for k, p in enumerate(points, start=1)))
+
+
+def test_external_sfm_model_is_scored_as_pycolmap(plane_dataset, tmp_path):
+    root, cams = plane_dataset
+    pts = [(0.1, 0.2, 0.0), (-1.0, 0.5, 0.0), (0.7, -0.3, 0.0), (0.2, 0.2, 0.05)]  # the last 5 cm off the plane
+    _colmap_text_model(tmp_path / "answer", cams, ["left_000", "right_000", "free_000"], pts)
+    tool = tmp_path / "sfm.py"
+    tool.write_text("import shutil, sys, pathlib\nassert sorted(p.name for p in pathlib.Path(sys.argv[1]).iterdir()) =="
+                    " ['free_000.png', 'left_000.png', 'right_000.png']\n"
+                    f"shutil.copytree({str(tmp_path / 'answer')!r}, sys.argv[2], dirs_exist_ok=True)\n")
+    m = external_method("my-sfm", "sfm", f"{{python}} {tool} {{images}} {{out}}")
+    assert m.task == "structure from motion"
+    doc = run_method("my-sfm", root, tmp_path / "run", declared={"my-sfm": m})
+    met = doc["metrics"]
+    assert met["registration_ratio"] == 1.0 and met["max_rot_err_deg"] < 1e-6 and met["n_points3d"] == 4
+    assert met["cloud_precision_at_1cm"] == 0.75
+    assert doc["inputs"]["raw_files"] == ["model/cameras.txt", "model/images.txt", "model/points3D.txt"]
+    _colmap_text_model(tmp_path / "two", cams, ["left_000", "right_000"], pts)
+    tool.write_text(f"import shutil, sys\nshutil.copytree({str(tmp_path / 'two')!r}, sys.argv[2], dirs_exist_ok=True)\n")
+    doc = run_method("my-sfm", root, tmp_path / "run2", declared={"my-sfm": m})
+    assert doc["metrics"]["max_rot_err_deg"] == "inf" and "registers 2 images" in doc["inputs"]["notes"]["failed"]
+    tool.write_text("import sys\nsys.exit(4)\n")
+    doc = run_method("my-sfm", root, tmp_path / "run3", declared={"my-sfm": m})
+    assert doc["metrics"] == {"registration_ratio": 0.0, "max_rot_err_deg": "inf"}
+    assert doc["inputs"]["notes"]["sfm"]["failed"] == "exit status 4"
