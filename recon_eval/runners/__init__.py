@@ -57,7 +57,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
-         ("external", "sfm"): "structure from motion"}
+         ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
 
 
 def _m(name, module, function, description, **options):

@@ -42,6 +42,7 @@ from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.matrix import read_matrix3
 from recon_eval.readers.npy import read_mask
 from recon_eval.readers.pfm import read_pfm
+from recon_eval.runners import calibration as calib
 from recon_eval.runners import colmap, stereo, twoview
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
@@ -73,6 +74,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("disparity", "disparity", ("left", "right", "view1", "out"),
          "per rectified stereo frame: read {left} {right} (PNG), write the left disparity (PFM, px; inf/nan = none) "
          "to {out}; scored as the built-in stereo methods"),
+    Kind("calibration", "calibration", ("images", "camera", "out"),
+         "per spec camera: {images} is a folder of its views' images (<view>.png), {camera} its name; write its "
+         "calibration (OpenCV YAML/JSON: camera_matrix, distortion_coefficients, image size) to {out}; scored as "
+         "the built-in calibration methods"),
     Kind("sfm", "sfm", ("images", "out"),
          "once: {images} is a folder of <view>.png, write a COLMAP model (cameras, images, points3D; .bin or .txt; "
          "image names <view>.png) into the folder {out}; scored as pycolmap-incremental"),
@@ -281,4 +286,36 @@ def sfm(ds, out_dir, options) -> RunOutput:
         except InputError as exc:  # an unreadable model is the method's failure, not bad input
             _failed_output(out, "sfm", str(exc))
     out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
+    return out
+
+
+def calibration(ds, out_dir, options) -> RunOutput:
+    """The ``calibration`` kind (:data:`KINDS`): the built-in calibration scoring of each camera's file."""
+    groups: dict = {}
+    for v in ds.views:
+        groups.setdefault(ds.view_info(v).get("camera_name"), []).append(v)
+    out = RunOutput()
+    for cam, views in groups.items():
+        name = check_view_name(str(cam))
+        images, yaml_path = Path(out_dir) / f"images_{name}", out_path(out_dir, f"calibration_{name}.yaml")
+        shutil.rmtree(images, ignore_errors=True)
+        yaml_path.unlink(missing_ok=True)
+        images.mkdir(parents=True)
+        for v in views:
+            shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+        why = invoke(options, {"images": str(images.resolve()), "camera": name, "out": str(yaml_path.resolve()),
+                               "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs" / name, name, out)
+        shutil.rmtree(images, ignore_errors=True)
+        pre = "" if len(groups) == 1 else f"{name}."
+        if why is None and not yaml_path.is_file():
+            _failed_output(out, name, f"wrote no {yaml_path.name}")
+        elif why is None:
+            try:
+                calib.score_calibration(ds, out, name, pre, yaml_path, views, views, None)
+                out.raw_files.append(yaml_path.name)
+                continue
+            except InputError as exc:  # an unreadable file is the method's failure
+                _failed_output(out, name, str(exc))
+        for k in ("fx_rel_err", "fy_rel_err", "cx_abs_err_px", "cy_abs_err_px", "proj_diff_rms_px"):
+            out.metrics[pre + k] = float("inf")  # a failed calibration: every error inf, never dropped
     return out

@@ -291,3 +291,27 @@ def test_external_sfm_model_is_scored_as_pycolmap(plane_dataset, tmp_path):
     doc = run_method("my-sfm", root, tmp_path / "run3", declared={"my-sfm": m})
     assert doc["metrics"] == {"registration_ratio": 0.0, "max_rot_err_deg": "inf"}
     assert doc["inputs"]["notes"]["sfm"]["failed"] == "exit status 4"
+
+
+def test_external_calibration_is_scored_as_the_builtin(plane_dataset, tmp_path):
+    from recon_eval.readers.opencv_calib import write_opencv_calibration
+    from scenegen.geometry.camera import Camera
+
+    root, cams = plane_dataset
+    for view, cam in (("left_000", "left"), ("right_000", "right"), ("free_000", "free")):
+        c = cams[view][0]
+        if cam == "free":  # the planted error: fx 0.5 px too long
+            c = Camera(c.model, c.width, c.height, c.fx + 0.5, c.fy, c.cx, c.cy, 0.0, c.dist)
+        write_opencv_calibration(tmp_path / f"{cam}.yaml", c)
+    tool = tmp_path / "calib.py"
+    tool.write_text("import shutil, sys, pathlib\nimages, cam, out = sys.argv[1:]\n"
+                    "assert [p.name for p in pathlib.Path(images).iterdir()] == [cam + '_000.png']\n"
+                    f"shutil.copy(pathlib.Path({str(tmp_path)!r}) / (cam + '.yaml'), out)\n")
+    m = external_method("my-calib", "calibration", f"{{python}} {tool} {{images}} {{camera}} {{out}}")
+    doc = run_method("my-calib", root, tmp_path / "run", declared={"my-calib": m})
+    met = doc["metrics"]
+    assert met["left.fx_rel_err"] == 0 and met["right.proj_diff_rms_px"] < 1e-9
+    assert met["free.fx_rel_err"] == pytest.approx(0.5 / cams["free_000"][0].fx, abs=1e-15)
+    assert "free.calib_rms_px" not in met and doc["inputs"]["task"] == "calibration"
+    assert sorted(doc["inputs"]["raw_files"]) == ["calibration_free.yaml", "calibration_left.yaml",
+                                                   "calibration_right.yaml"]
