@@ -42,8 +42,7 @@ from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.matrix import read_matrix3
 from recon_eval.readers.npy import read_mask
 from recon_eval.readers.pfm import read_pfm
-from recon_eval.runners import calibration as calib
-from recon_eval.runners import colmap, stereo, twoview
+from recon_eval.runners import calibration as calib, colmap, stereo, twoview
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
 from scenegen.dataset.layout import check_view_name
