@@ -315,3 +315,27 @@ def test_external_calibration_is_scored_as_the_builtin(plane_dataset, tmp_path):
     assert "free.calib_rms_px" not in met and doc["inputs"]["task"] == "calibration"
     assert sorted(doc["inputs"]["raw_files"]) == ["calibration_free.yaml", "calibration_left.yaml",
                                                    "calibration_right.yaml"]
+
+
+def test_leaderboard_with_declared_methods_and_gates(plane_dataset, tmp_path, capsys):
+    """A methods file's method in `leaderboard`, gated there: exit 1 on a failed gate, the cell red,
+    the run's report rewritten with its gate outcomes, the inapplicable built-in listed as skipped."""
+    root, cams = plane_dataset
+    _colmap_text_model(tmp_path / "answer", cams, ["left_000", "right_000", "free_000"], [(0.1, 0.2, 0.0)])
+    tool = tmp_path / "sfm.py"
+    tool.write_text(f"import shutil, sys\nshutil.copytree({str(tmp_path / 'answer')!r}, sys.argv[2], dirs_exist_ok=True)\n")
+    (tmp_path / "m.yaml").write_text(f"version: 1\nmethods:\n  - {{name: my-sfm, kind: sfm, command: "
+                                     f"'{{python}} {tool} {{images}} {{out}}'}}\n")
+    (tmp_path / "g.yaml").write_text("version: 1\ngates:\n"
+                                     "  - {method: 'my-*', metric: registration_ratio, op: '==', threshold: 1}\n"
+                                     "  - {method: 'my-*', metric: n_points3d, op: '>=', threshold: 100}\n")
+    code, out, err = run(["leaderboard", "--methods-file", tmp_path / "m.yaml", "--datasets", root, "--methods",
+                          "my-sfm", "opencv-stereo-bm", "--gates", tmp_path / "g.yaml", "-o", tmp_path / "b"], capsys)
+    assert code == 1, err
+    assert "ok   registration_ratio = 1" in out and "FAIL n_points3d = 1, threshold >= 100" in out
+    page = (tmp_path / "b" / "leaderboard.html").read_text()
+    assert "<h2>structure from motion</h2>" in page and 'class="num best fail"' in page and 'class="num best pass"' in page
+    assert "<h2>Skipped</h2>" in page and "opencv-stereo-bm" in page
+    report = (tmp_path / "b" / json.loads((tmp_path / "b" / "leaderboard.json").read_text())["run_dirs"][0]
+              / "report.html").read_text()
+    assert "gate n_points3d &gt;= 100" in report and 'class="verdict fail"' in report
