@@ -15,7 +15,7 @@ def _by_the_paper(q, gt, gt_occ, pred, pred_occ, size, mode, eval_size):
     counts = {d: [0, 0, 0] for d in (1, 2, 4, 8, 16)}  # correct, true positives, false positives
     n_ev = n_vis = agree = 0
     for i in range(gt.shape[0]):
-        qf = int(round(q[i, 0]))
+        qf = int(np.rint(q[i, 0]))
         for t in range(gt.shape[1]):
             if (mode == "first" and t <= qf) or (mode == "strided" and t == qf):
                 continue
