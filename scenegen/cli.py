@@ -21,7 +21,7 @@ EXIT_BAD_INPUT = 2
 #: ``--variant`` choices: scenegen.spec.model.RENDER_VARIANTS (equal, tests/scenegen/test_cli.py)
 RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 #: ``export --format`` choices: scenegen.export.FORMATS (equal, tests/scenegen/test_cli.py)
-EXPORT_FORMATS = ("colmap", "nerf", "kitti-stereo", "middlebury", "opencv", "tum")
+EXPORT_FORMATS = ("colmap", "gaussian-splatting", "nerf", "kitti-stereo", "middlebury", "opencv", "tum")
 
 
 def _err(msg: str) -> int:
