@@ -23,8 +23,9 @@ from scenegen.export.common import open_dataset, staged_dest
 from scenegen.export.errors import ExportError
 
 #: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
-FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export, "kitti-stereo": kitti_stereo.export,
-           "middlebury": middlebury.export, "opencv": opencv_yaml.export, "tum": tum.export}
+FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
+           "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
+           "tum": tum.export}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

@@ -68,7 +68,8 @@ def tracks(ds, cams: dict, poses: dict, vid: dict) -> tuple[dict[str, list], lis
             seen = []
             for view in [i] + [j for j in others if vis[j][k]]:
                 uv = cams[view].project(poses[view].apply(X[None]))[0]
-                if np.all(np.isfinite(uv)) and 0 <= uv[0] + 0.5 <= cams[view].width and 0 <= uv[1] + 0.5 <= cams[view].height:
+                inside = 0 <= uv[0] + 0.5 <= cams[view].width and 0 <= uv[1] + 0.5 <= cams[view].height
+                if np.all(np.isfinite(uv)) and inside:
                     seen.append((view, uv))
             if len(seen) < 2:
                 continue
@@ -96,8 +97,8 @@ def write_model(ds, dest, folder: str, cams: dict, poses: dict) -> dict:
         img_lines.append(" ".join(f"{fmt(uv[0])} {fmt(uv[1])} {pid}" for uv, pid in obs[v]))
     pre = f"{folder}/" if folder else ""
     write(dest, pre + "cameras.txt", (HEAD + "# CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]\n" + "\n".join(cam_lines) + "\n").encode())
-    write(dest, pre + "images.txt", (HEAD + "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n"
-                                     + "\n".join(img_lines) + "\n").encode())
-    write(dest, pre + "points3D.txt", (HEAD + "# POINT3D_ID X Y Z R G B ERROR TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
-                                       + "\n".join(pt_lines) + ("\n" if pt_lines else "")).encode())
+    img_head = "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n"
+    write(dest, pre + "images.txt", (HEAD + img_head + "\n".join(img_lines) + "\n").encode())
+    pt_head = "# POINT3D_ID X Y Z R G B ERROR TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+    write(dest, pre + "points3D.txt", (HEAD + pt_head + "\n".join(pt_lines) + ("\n" if pt_lines else "")).encode())
     return {"cameras": len(cam_lines), "images": len(cams), "points3D": len(pt_lines)}

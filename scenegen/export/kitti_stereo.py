@@ -40,13 +40,15 @@ def calib_cam_to_cam(calib: dict) -> str:
     right_from_left = pr @ pl.inverse()
     W, H = calib["size"]
     lines = ["calib_time: scenegen truth", "corner_dist: 0.000000e+00"]
-    for xx, (cam, ext, R_rect, P) in enumerate(((cl, None, calib["R1"], calib["P1"]), (cr, right_from_left, calib["R2"], calib["P2"]),
-                                                 (cl, None, calib["R1"], calib["P1"]), (cr, right_from_left, calib["R2"], calib["P2"]))):
+    left = (cl, None, calib["R1"], calib["P1"])
+    right = (cr, right_from_left, calib["R2"], calib["P2"])
+    for xx, (cam, ext, R_rect, P) in enumerate((left, right, left, right)):
         K, D = cam.to_opencv()
         R, T = (np.eye(3), np.zeros(3)) if ext is None else (ext.R, ext.t)
-        lines += [f"S_{xx:02d}: {cam.width:.6e} {cam.height:.6e}", f"K_{xx:02d}: {_row(K)}", f"D_{xx:02d}: {_row(D)}",
-                  f"R_{xx:02d}: {_row(R)}", f"T_{xx:02d}: {_row(T)}", f"S_rect_{xx:02d}: {W:.6e} {H:.6e}",
-                  f"R_rect_{xx:02d}: {_row(R_rect)}", f"P_rect_{xx:02d}: {_row(P)}"]
+        lines += [f"S_{xx:02d}: {cam.width:.6e} {cam.height:.6e}", f"K_{xx:02d}: {_row(K)}",
+                  f"D_{xx:02d}: {_row(D)}", f"R_{xx:02d}: {_row(R)}", f"T_{xx:02d}: {_row(T)}",
+                  f"S_rect_{xx:02d}: {W:.6e} {H:.6e}", f"R_rect_{xx:02d}: {_row(R_rect)}",
+                  f"P_rect_{xx:02d}: {_row(P)}"]
     return "\n".join(lines) + "\n"
 
 
@@ -57,7 +59,8 @@ def obj_map(ds, fr) -> np.ndarray | None:
         return None
     ids = fr.instance_ids("left")
     if ids.max(initial=0) > 255:
-        raise ExportError(f"stereo frame {fr.left_view}: instance id {int(ids.max())} does not fit KITTI's 8-bit obj_map")
+        raise ExportError(f"stereo frame {fr.left_view}: instance id {int(ids.max())} does not fit"
+                          " KITTI's 8-bit obj_map")
     return ids.astype(np.uint8)
 
 

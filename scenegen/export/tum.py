@@ -54,6 +54,7 @@ def export(ds, dest) -> dict:
         write(dest, f"{key}/groundtruth.txt", traj)
         write(dest, f"{key}/rgb.txt", _list("color images", rgb))
         write(dest, f"{key}/depth.txt", _list("depth maps", depth))
-        write(dest, f"{key}/associations.txt", "".join(f"{a} {fa} {b} {fb}\n" for (a, fa), (b, fb) in zip(rgb, depth)).encode())
+        assoc = "".join(f"{a} {fa} {b} {fb}\n" for (a, fa), (b, fb) in zip(rgb, depth))
+        write(dest, f"{key}/associations.txt", assoc.encode())
         n += 5 + 2 * len(items)
     return {"files": n, "streams": sorted(streams), "depth_beyond_range": too_far}

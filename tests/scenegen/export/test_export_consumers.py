@@ -157,7 +157,7 @@ def test_kitti_calib_cam_to_cam_and_obj_map(ds, tmp_path):
         P = {k: cal[f"P_rect_{k}"].reshape(3, 4) for k in ("00", "01", "02", "03")}  # pykitti's raw loader
         R_rect_00 = cal["R_rect_00"].reshape(3, 3)
         assert -P["03"][0, 3] / P["03"][0, 0] == pytest.approx(fr.baseline_m, rel=1e-11)
-        (cl, pl), (cr, pr) = ds.camera(f["left_view"]), ds.camera(f["right_view"])
+        (cl, pl), (_, pr) = ds.camera(f["left_view"]), ds.camera(f["right_view"])
         assert np.allclose(cal["K_02"].reshape(3, 3), cl.K) and np.allclose(cal["D_02"], cl.to_opencv()[1].ravel())
         # a raw left point through KITTI's chain P_rect_02 R_rect_00 lands where the rectified truth says
         t = ds.truth(f["left_view"])
@@ -207,7 +207,7 @@ def test_middlebury_middeval3_names(ds, tmp_path):
 def test_tum_rgbd_layout(ds, tmp_path):
     dest = run_export(ds, "tum", tmp_path)
     root = dest / "st_left"
-    rows = lambda p: [l.split() for l in p.read_text().splitlines() if l and not l.startswith("#")]  # noqa: E731
+    rows = lambda p: [ln.split() for ln in p.read_text().splitlines() if ln and not ln.startswith("#")]  # noqa: E731
     rgb, depth, assoc = rows(root / "rgb.txt"), rows(root / "depth.txt"), rows(root / "associations.txt")
     gt = rows(root / "groundtruth.txt")
     assert [r[0] for r in rgb] == [r[0] for r in depth] == [r[0] for r in gt] == ["0.000000", "1.000000"]
