@@ -102,6 +102,7 @@ def test_only_render_imports_mitsuba():
 #: What each scenegen layer may import from the project besides itself (docs/architecture.md).
 SCENEGEN_LAYERS = {
     "scenegen.errors": (),
+    "scenegen.bundled": (),  # the package data (example scenes and gates), standard library only
     "scenegen.located_yaml": ("scenegen.errors",),
     "scenegen.geometry": (),
     "scenegen.dataset": ("scenegen.geometry",),
@@ -114,8 +115,10 @@ SCENEGEN_LAYERS = {
     "scenegen.render": ("scenegen.errors", "scenegen.geometry", "scenegen.assets", "scenegen.spec",
                         "scenegen.dataset.crossview"),
     "scenegen.export": ("scenegen.geometry", "scenegen.dataset"),
+    # the preview composes its sheet with the gallery's code (scenegen.export.sheet), the layer below
     "scenegen.pipeline": ("scenegen.errors", "scenegen.geometry", "scenegen.dataset", "scenegen.assets",
-                          "scenegen.imaging", "scenegen.crossview", "scenegen.spec", "scenegen.render"),
+                          "scenegen.imaging", "scenegen.crossview", "scenegen.spec", "scenegen.render",
+                          "scenegen.export"),
 }
 
 

@@ -30,7 +30,8 @@ def disparity_arguments(p) -> None:
     p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr; "
                                     "a Middlebury mask0nocc.png: 255 = evaluated)")
     p.add_argument("--obj-map", help="KITTI foreground map PNG")
-    p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti")
+    p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti",
+                   help="whose metrics: KITTI D1, Middlebury v3 bad-x/avgerr, ETH3D two-view (default kitti)")
     p.add_argument("--ndisp", type=float, help="Middlebury: clip estimates to [0, NDISP] as evaldisp does (default: "
                                                "ndisp of the calib.txt beside the truth file; for a dataset truth "
                                                "the export's max(16, 16 ceil(max d / 16)))")

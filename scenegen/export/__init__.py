@@ -22,7 +22,8 @@ from scenegen.export import colmap, gaussian_splatting, kitti_stereo, middlebury
 from scenegen.export.common import open_dataset, staged_dest
 from scenegen.export.errors import ExportError
 
-#: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
+#: Format name -> its exporter ``export(dataset, dest, progress=None) -> summary dict``
+#: (``progress(done, total)`` after each view, stereo frame or reference view).
 FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export}
@@ -34,14 +35,15 @@ def default_dest(out_dir, fmt: str) -> Path:
     return p.parent / f"{p.name}.{fmt}"
 
 
-def export(out_dir, fmt: str, dest=None) -> dict:
+def export(out_dir, fmt: str, dest=None, progress=None) -> dict:
     """Export dataset ``out_dir`` as ``fmt`` into ``dest`` (default :func:`default_dest`);
-    returns a summary dict ``{"dest": ..., "files": n, ...}``."""
+    returns a summary dict ``{"dest": ..., "files": n, ...}``; ``progress(done, total)``
+    is called as the exporter goes (views, stereo frames or reference views)."""
     if fmt not in FORMATS:
         raise ExportError(f"unknown export format {fmt!r}; choose one of {', '.join(FORMATS)}")
     ds = open_dataset(out_dir)
     dest = Path(dest) if dest is not None else default_dest(out_dir, fmt)
     with staged_dest(dest) as stage:  # a refused export leaves no folder behind
-        summary = FORMATS[fmt](ds, stage)
+        summary = FORMATS[fmt](ds, stage, progress)
     summary["dest"] = str(dest)
     return summary

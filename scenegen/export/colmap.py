@@ -12,11 +12,11 @@ from scenegen.dataset.layout import view_paths
 from scenegen.export.colmap_model import write_model
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     cams, poses = {}, {}
     for v in ds.views:
         cams[v], poses[v] = ds.camera(v)
-    counts = write_model(ds, dest, "", cams, poses)
+    counts = write_model(ds, dest, "", cams, poses, progress)
     (dest / "images").mkdir(exist_ok=True)
     for v in ds.views:
         shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.dataset.crossview import VISIBLE
-from scenegen.export.common import crossview_index, fmt, write
+from scenegen.export.common import crossview_index, each, fmt, write
 from scenegen.geometry.color import to_uint8
 from scenegen.geometry.conventions import colmap_from_opencv_pixels, colmap_pose
 
@@ -50,12 +50,12 @@ def _links(index, vid) -> dict[str, list[str]]:
     return links
 
 
-def tracks(ds, cams: dict, poses: dict, vid: dict) -> tuple[dict[str, list], list[str]]:
+def tracks(ds, cams: dict, poses: dict, vid: dict, progress=None) -> tuple[dict[str, list], list[str]]:
     """(view -> [(COLMAP uv, point id)], points3D.txt lines) of the truth tracks (module docstring)."""
     index = crossview_index(ds)
     obs: dict[str, list] = {v: [] for v in cams}
     pt_lines, point_id = [], 0
-    for i, others in _links(index, vid).items():
+    for i, others in each(_links(index, vid).items(), progress):
         truth = ds.truth(i)
         image = to_uint8(ds.image(i))
         H, W = truth["valid"].shape
@@ -84,12 +84,12 @@ def tracks(ds, cams: dict, poses: dict, vid: dict) -> tuple[dict[str, list], lis
     return obs, pt_lines
 
 
-def write_model(ds, dest, folder: str, cams: dict, poses: dict) -> dict:
+def write_model(ds, dest, folder: str, cams: dict, poses: dict, progress=None) -> dict:
     """Write ``dest/folder/{cameras,images,points3D}.txt`` for the views of ``cams`` (view ->
-    Camera, view -> cam_from_world); returns counts."""
+    Camera, view -> cam_from_world); returns counts; ``progress(done, total)`` per reference view."""
     vid = {v: k + 1 for k, v in enumerate(cams)}
     cam_of_view, cam_lines = camera_ids(ds, cams)
-    obs, pt_lines = tracks(ds, cams, poses, vid)
+    obs, pt_lines = tracks(ds, cams, poses, vid, progress)
     img_lines = []
     for v in cams:
         q, t = colmap_pose(poses[v])

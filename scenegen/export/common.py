@@ -97,3 +97,12 @@ def depth_png16(depth_z, valid, units_per_m: float) -> tuple[np.ndarray, int]:
         q = np.rint(np.where(valid, depth_z, 0.0).astype(np.float64) * units_per_m)
     fits = valid & (q >= 1) & (q <= 65535)
     return np.where(fits, q, 0).astype(np.uint16), int(np.count_nonzero(valid & ~fits))
+
+
+def each(items, progress=None):
+    """The items, calling ``progress(done, total)`` after each (when given)."""
+    items = list(items)
+    for k, item in enumerate(items):
+        yield item
+        if progress is not None:
+            progress(k + 1, len(items))

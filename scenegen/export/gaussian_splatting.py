@@ -20,7 +20,7 @@ import numpy as np
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.layout import view_paths
 from scenegen.export.colmap_model import write_model
-from scenegen.export.common import write
+from scenegen.export.common import each, write
 from scenegen.geometry.camera import Camera
 
 
@@ -43,10 +43,10 @@ def undistorted_image(image: np.ndarray, cam: Camera, pin: Camera) -> np.ndarray
     return cv2.remap(image, m[..., 0], m[..., 1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     cams, poses, resampled = {}, {}, 0
     (dest / "images").mkdir(exist_ok=True)
-    for v in ds.views:
+    for v in each(ds.views, progress):
         cam, poses[v] = ds.camera(v)
         cams[v] = pin = pinhole_of(cam)
         if pin == cam:

@@ -25,7 +25,7 @@ import numpy as np
 from scenegen.dataset.cameras import camera_of
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.layout import stereo_dir, stereo_path
-from scenegen.export.common import stereo_frames, write
+from scenegen.export.common import each, stereo_frames, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
 
@@ -64,10 +64,10 @@ def obj_map(ds, fr) -> np.ndarray | None:
     return ids.astype(np.uint8)
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     frames = stereo_frames(ds)
     out, n_obj = [], 0
-    for k, fr in enumerate(frames):
+    for k, fr in enumerate(each(frames, progress)):
         tag = f"{k:06d}"
         for side, folder in (("left", "image_2"), ("right", "image_3")):
             write(dest, f"training/{folder}/{tag}_10.png", encode_png(to_uint8(fr.image(side))))

@@ -18,7 +18,7 @@ import numpy as np
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.crossview import VISIBLE
 from scenegen.dataset.layout import stereo_path
-from scenegen.export.common import stereo_frames, write
+from scenegen.export.common import each, stereo_frames, write
 
 TRAINING = "trainingF"
 
@@ -28,9 +28,9 @@ def _mat(K) -> str:
     return "[" + "; ".join(" ".join(repr(float(x)) for x in row) for row in K) + "]"
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     frames = stereo_frames(ds)
-    for fr in frames:
+    for fr in each(frames, progress):
         name = f"{TRAINING}/{fr.left_view}"  # a checked view name
         (dest / name).mkdir(parents=True, exist_ok=True)
         for key, side, dst in (("image", "left", "im0.png"), ("image", "right", "im1.png"),

@@ -30,7 +30,7 @@ import numpy as np
 
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.layout import view_paths
-from scenegen.export.common import depth_png16, write
+from scenegen.export.common import depth_png16, each, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.camera import camera_model
 from scenegen.geometry.conventions import colmap_from_opencv_pixels, opengl_cam_to_world
@@ -67,10 +67,10 @@ def _json(doc) -> bytes:
     return (json.dumps(doc, indent=2, sort_keys=True) + "\n").encode()
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     frames, all_intr, too_far = [], [], 0
     (dest / "images").mkdir(exist_ok=True)
-    for v in ds.views:
+    for v in each(ds.views, progress):
         cam, pose = ds.camera(v)
         intr = intrinsics(cam)
         all_intr.append(json.dumps(intr, sort_keys=True))

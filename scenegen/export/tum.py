@@ -29,13 +29,14 @@ def _list(kind: str, rows) -> bytes:
     return (f"# {kind}\n# timestamp filename\n" + "".join(f"{ts} {f}\n" for ts, f in rows)).encode()
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     streams: dict[str, list] = {}
     for v in ds.views:
         info = ds.view_info(v)
         key = name("stream", f"{info['rig']}_{info['rig_member']}" if info.get("rig") else info["camera_name"])
         streams.setdefault(key, []).append((info["frame_index"], v))
     n, too_far = 0, 0
+    done = 0
     for key, items in streams.items():
         lines, rgb, depth = [TRAJECTORY_HEAD], [], []
         for frame, v in sorted(items):
@@ -57,4 +58,7 @@ def export(ds, dest) -> dict:
         assoc = "".join(f"{a} {fa} {b} {fb}\n" for (a, fa), (b, fb) in zip(rgb, depth))
         write(dest, f"{key}/associations.txt", assoc.encode())
         n += 5 + 2 * len(items)
+        done += len(items)
+        if progress is not None:
+            progress(done, len(ds.views))
     return {"files": n, "streams": sorted(streams), "depth_beyond_range": too_far}

@@ -38,6 +38,7 @@ class LoadedScene:
     emitters: list = field(default_factory=list)  # per spec light, spec order: (Mitsuba key of
     # its power, loaded value = spec power, key of its sampling weight, loaded weight)
     light_scales: tuple = ()  # factor on each spec light's power now in the loaded scene
+    sampler: str = "ldsampler"  # the sensors' Mitsuba sampler plugin (it rounds spp up: effective_spp)
 
     @property
     def variant(self) -> str:
@@ -78,7 +79,7 @@ def object_key(obj) -> str:
 def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) -> LoadedScene:
     """Load ``spec`` into Mitsuba (current variant) with one of our sensors per spec camera."""
     sensor_mod.register()
-    built = LoadedScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=())
+    built = LoadedScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=(), sampler=sampler)
     d: dict = {"type": "scene", "integrator": {"type": "path", "max_depth": int(max_depth)}}
     object_ids, instance_ids = {}, {}
     for obj in spec.objects:

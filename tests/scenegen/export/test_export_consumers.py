@@ -249,7 +249,7 @@ def test_rectification_maps_read_in_opencv(ds, tmp_path):
 def test_refused_export_leaves_no_folder(ds, tmp_path, capsys, monkeypatch):
     from scenegen import export as ex
 
-    def half_then_refuse(d, dest):
+    def half_then_refuse(d, dest, progress=None):
         (dest / "images").mkdir()
         (dest / "images" / "x.png").write_bytes(b"x")
         raise ex.ExportError("refused for the test")
