@@ -61,9 +61,10 @@ def cmd_validate(args) -> int:
 def cmd_render(args) -> int:
     from scenegen.pipeline.batch import render_many  # the command's implementation, on use
     from scenegen.pipeline.run import render_spec  # the command's implementation, on use
+    from scenegen.render.backend import renderer_log  # the command's implementation, on use
 
     many = args.variants is not None or args.workers is not None or args.scheduler is not None
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), renderer_log(args.verbosity > QUIET):
         warnings.simplefilter("always")
         kw = dict(frames=args.frames, spp=args.spp, seed=args.seed, variant=args.variant,
                   resume=args.resume, progress=args.verbosity > QUIET and not args.no_progress)
@@ -146,9 +147,11 @@ def cmd_verify(args) -> int:
 
 def cmd_preview(args) -> int:
     from scenegen.pipeline.preview import preview  # the command's implementation, on use
+    from scenegen.render.backend import renderer_log  # the command's implementation, on use
 
-    r = preview(args.spec, args.output, spp=args.spp, max_width=args.tile_width, variant=args.variant,
-                progress=args.verbosity > QUIET)
+    with renderer_log(args.verbosity > QUIET):
+        r = preview(args.spec, args.output, spp=args.spp, max_width=args.tile_width, variant=args.variant,
+                    progress=args.verbosity > QUIET)
     print(f"wrote {r['png']}: {r['views']} views x (image, depth, normals, ids), spp {r['spp']}, "
           f"{r['seconds']:.1f} s")
     return 0

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
+from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape, stderr_progress
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
@@ -128,7 +128,9 @@ def _dataset_depths(a, ds):
             ds.check_view(v)
         est_list, missing = [], []
         gt_list = [ds.depth(v) for v in views]
-        for v, g in zip(views, gt_list):
+        progress = stderr_progress("depth maps (views)")
+        for k, (v, g) in enumerate(zip(views, gt_list)):
+            progress(k + 1, len(views))
             f = find_view_map(a.est, v)
             if f is None:
                 missing.append(v)

@@ -9,7 +9,8 @@
   conversion copies COLMAP's cx, cy unchanged.
 * ``depth_file_path``: ``depth/<view>.png``, uint16 z-depth (along the optical axis) in
   millimetres, 0 = no surface or beyond 65.535 m: nerfstudio's default ``depth_unit_scale_factor``
-  of 1e-3 turns it into metres.
+  of 1e-3 turns it into metres; the same file as instant-ngp's ``depth_path`` with its
+  ``integer_depth_scale`` = 0.001 (metres per unit).
 * ``mask_path``: ``masks/<view>.png``, the truth's valid mask (uint8 grey, 255 where the pixel
   centre's ray hits a surface, 0 on the background); nerfstudio ignores pixels where it is 0.
 * Split: every ``TEST_EVERY``-th view (0, 8, 16, ... in the run's order; none with fewer than 2
@@ -80,6 +81,7 @@ def export(ds, dest, progress=None) -> dict:
         write(dest, f"depth/{v}.png", encode_png(depth))
         write(dest, f"masks/{v}.png", encode_png(np.where(truth["valid"], 255, 0).astype(np.uint8)))
         frames.append({"file_path": f"images/{v}.png", "depth_file_path": f"depth/{v}.png",
+                       "depth_path": f"depth/{v}.png",
                        "mask_path": f"masks/{v}.png", **intr,
                        "transform_matrix": opengl_cam_to_world(pose).tolist()})
         shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
@@ -91,6 +93,7 @@ def export(ds, dest, progress=None) -> dict:
         shared["camera_angle_y"] = 2 * math.atan(0.5 * shared["h"] / shared["fl_y"])
     files = {k: [f"images/{v}.png" for v in parts[k]] for k in parts}
     doc = {"applied_transform": np.eye(4)[:3].tolist(), "frames": frames, **shared,
+           "integer_depth_scale": 1.0 / DEPTH_UNITS_PER_M,
            "train_filenames": files["train"], "val_filenames": files["test"], "test_filenames": files["test"]}
     write(dest, "transforms.json", _json(doc))
     by_file = {f["file_path"]: f for f in frames}

@@ -113,3 +113,21 @@ def test_info_json(crossview_render, capsys):
         cam, pose = ds.camera(v)
         assert doc["views"][v]["camera"]["K"] == cam.K.tolist()
         assert np.allclose(doc["views"][v]["centre_m"], pose.inverse().t)
+
+
+def test_mitsuba_log_lines_in_our_words(capfd):
+    from scenegen.render.backend import load_mitsuba, renderer_log_line, set_renderer_log
+
+    mi = load_mitsuba("llvm_ad_rgb")
+    try:
+        mi.load_dict({"type": "ldsampler", "sample_count": 3})  # Mitsuba warns: it rounds to 4
+        out, err = capfd.readouterr()
+        assert err.strip() == ("scenegen: Mitsuba warning: [LowDiscrepancySampler] Sample count should be square "
+                               "and power of two, rounding to 4") and "WARN" not in out + err
+        set_renderer_log(False)  # -q
+        mi.load_dict({"type": "ldsampler", "sample_count": 5})
+        assert capfd.readouterr() == ("", "")
+    finally:
+        set_renderer_log(True)
+    assert renderer_log_line("error", "2026-01-01 00:00:00 ERROR [Scene] no shapes") == \
+        "scenegen: Mitsuba error: [Scene] no shapes"

@@ -26,9 +26,12 @@ def ds(crossview_render):
     return Dataset(crossview_render[1])
 
 
-def run_export(ds, fmt, tmp_path):
+def run_export(ds, fmt, tmp_path, capsys=None):
     dest = tmp_path / fmt
     assert main(["export", str(ds.root), "--format", fmt, "-o", str(dest)]) == 0
+    if capsys is not None:  # progress on stderr, counted
+        err = capsys.readouterr().err
+        assert f"scenegen: export {fmt}: " in err and "/" in err
     return dest
 
 
@@ -96,8 +99,8 @@ def _nerf_frame_intrinsics(doc, fr):
     return fl_x, get("fl_y") or fl_x, get("cx"), get("cy"), [get(k) or 0.0 for k in ("k1", "k2", "k3", "k4", "p1", "p2")]
 
 
-def test_nerf_transforms_by_the_consumer_rules(ds, tmp_path):
-    dest = run_export(ds, "nerf", tmp_path)
+def test_nerf_transforms_by_the_consumer_rules(ds, tmp_path, capsys):
+    dest = run_export(ds, "nerf", tmp_path, capsys)
     doc = json.loads((dest / "transforms.json").read_text())
     files = [f["file_path"] for f in doc["frames"]]
     train, test = doc["train_filenames"], doc["test_filenames"]
@@ -118,6 +121,7 @@ def test_nerf_transforms_by_the_consumer_rules(ds, tmp_path):
         assert depth.dtype == np.uint16 and mask.dtype == np.uint8 and mask.ndim == 2
         assert np.array_equal(mask > 0, truth["valid"])  # nerfstudio: nonzero = used
         z = depth * 1e-3  # nerfstudio's default depth_unit_scale_factor
+        assert fr["depth_path"] == fr["depth_file_path"] and doc["integer_depth_scale"] == 1e-3  # instant-ngp
         ok = truth["valid"]
         assert np.array_equal(depth > 0, ok)
         worst_mm = max(worst_mm, float(np.abs(z[ok] - truth["depth_z"][ok]).max()) * 1e3)
