@@ -124,11 +124,12 @@ def cmd_info(args) -> int:
 
 
 def cmd_export(args) -> int:
-    from scenegen.export import export  # the command's implementation, on use
+    from scenegen.export import PROGRESS_UNITS, export  # the command's implementation, on use
     from scenegen.pipeline.progress import line_progress  # the command's implementation, on use
 
     s = export(args.dataset, args.format, args.output,
-               progress=line_progress(f"export {args.format}", "items", enabled=args.verbosity > QUIET))
+               progress=line_progress(f"export {args.format}", PROGRESS_UNITS[args.format],
+                                      enabled=args.verbosity > QUIET))
     extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
     print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
     return 0

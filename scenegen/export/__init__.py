@@ -27,6 +27,9 @@ from scenegen.export.errors import ExportError
 FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export}
+#: What each exporter's progress counts.
+PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
+                  "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

@@ -31,7 +31,7 @@ def run_export(ds, fmt, tmp_path, capsys=None):
     assert main(["export", str(ds.root), "--format", fmt, "-o", str(dest)]) == 0
     if capsys is not None:  # progress on stderr, counted
         err = capsys.readouterr().err
-        assert f"scenegen: export {fmt}: " in err and "/" in err
+        assert f"scenegen: export {fmt}: " in err and "/" in err and " views (" in err
     return dest
 
 
