@@ -39,6 +39,7 @@ def staged_dest(dest: Path):
     ``dest`` when the block ends normally, removed when it raises: a refused or failed export
     leaves nothing behind (an empty ``dest`` that existed before stays as it was)."""
     check_dest(dest)
+    created = [p for p in reversed(dest.parents) if not p.exists()]  # outermost first
     dest.parent.mkdir(parents=True, exist_ok=True)
     stage = dest.parent / f".{dest.name}.partial-{os.getpid()}"
     if stage.exists():
@@ -50,9 +51,13 @@ def staged_dest(dest: Path):
         if dest.exists():
             dest.rmdir()
         stage.rename(dest)
-    finally:
+    except BaseException:
         if stage.exists():
             shutil.rmtree(stage)
+        for p in reversed(created):  # the folders made for it, innermost first, if still empty
+            if p.is_dir() and not any(p.iterdir()):
+                p.rmdir()
+        raise
 
 
 def name(kind: str, value: str) -> str:

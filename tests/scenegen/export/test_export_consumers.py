@@ -266,6 +266,8 @@ def test_refused_export_leaves_no_folder(ds, tmp_path, capsys, monkeypatch):
     dest.mkdir()  # an empty destination given by the user is kept as it was
     assert main(["export", str(ds.root), "--format", "nerf", "-o", str(dest)]) == 2
     assert [p.name for p in tmp_path.iterdir()] == ["out.nerf"] and not any(dest.iterdir())
+    assert main(["export", str(ds.root), "--format", "nerf", "-o", str(tmp_path / "new/deep/out")]) == 2
+    assert [p.name for p in tmp_path.iterdir()] == ["out.nerf"]  # the folders made for it are gone too
     monkeypatch.undo()
     assert main(["export", str(ds.root), "--format", "nerf", "-o", str(dest)]) == 0  # not blocked
     assert (dest / "transforms.json").is_file()
