@@ -13,13 +13,18 @@ Shared by the ``colmap`` export (the views' own cameras, distortion included) an
   where it is VISIBLE and its projection through the model's camera is finite. Each observation
   is that exact projection (reprojection errors are 0 up to float64), in COLMAP pixels. The same
   surface point seen from two reference views is two COLMAP points (truth is per pixel).
+* Without cross-view truth (a spec with no ``crossview:`` section), every view is a reference
+  view with no partner: its grid pixels with a surface become points observed in that view only
+  (track length 1; what a 3DGS initialisation needs, exact but with no multi-view constraint).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from scenegen.dataset import DatasetError
 from scenegen.dataset.crossview import VISIBLE
-from scenegen.export.common import crossview_index, each, fmt, write
+from scenegen.export.common import each, fmt, write
+from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
 from scenegen.geometry.conventions import colmap_from_opencv_pixels, colmap_pose
 
@@ -52,17 +57,23 @@ def _links(index, vid) -> dict[str, list[str]]:
 
 def tracks(ds, cams: dict, poses: dict, vid: dict, progress=None) -> tuple[dict[str, list], list[str]]:
     """(view -> [(COLMAP uv, point id)], points3D.txt lines) of the truth tracks (module docstring)."""
-    index = crossview_index(ds)
+    try:
+        index = ds.crossview.index  # None: no cross-view truth, single-view tracks
+    except DatasetError as e:
+        raise ExportError(str(e)) from None
+    links = _links(index, vid) if index is not None else {v: [] for v in cams}
+    min_track = 2 if index is not None else 1
     obs: dict[str, list] = {v: [] for v in cams}
     pt_lines, point_id = [], 0
-    for i, others in each(_links(index, vid).items(), progress):
+    for i, others in each(links.items(), progress):
         truth = ds.truth(i)
         image = to_uint8(ds.image(i))
         H, W = truth["valid"].shape
         gv, gu = np.meshgrid(np.arange(0, H, STRIDE_PX), np.arange(0, W, STRIDE_PX), indexing="ij")
         gv, gu = gv.ravel(), gu.ravel()
         vis = {j: ds.crossview.correspondence(i, j).state[gv, gu] == VISIBLE for j in others}
-        any_vis = np.any(np.stack(list(vis.values())), axis=0) & truth["valid"][gv, gu]
+        seen_elsewhere = np.any(np.stack(list(vis.values())), axis=0) if vis else np.ones(gv.shape, bool)
+        any_vis = seen_elsewhere & truth["valid"][gv, gu]
         for k in np.flatnonzero(any_vis):
             X = truth["points_world"][gv[k], gu[k]].astype(np.float64)
             seen = []
@@ -71,7 +82,7 @@ def tracks(ds, cams: dict, poses: dict, vid: dict, progress=None) -> tuple[dict[
                 inside = 0 <= uv[0] + 0.5 <= cams[view].width and 0 <= uv[1] + 0.5 <= cams[view].height
                 if np.all(np.isfinite(uv)) and inside:
                     seen.append((view, uv))
-            if len(seen) < 2:
+            if len(seen) < min_track:
                 continue
             point_id += 1
             track = []

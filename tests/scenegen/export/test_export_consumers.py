@@ -26,6 +26,29 @@ def ds(crossview_render):
     return Dataset(crossview_render[1])
 
 
+NO_CROSSVIEW = """
+name: orbit
+render: {spp: 4}
+objects:
+  - {name: floor, shape: {type: plane, size: [4, 4]}}
+  - {name: ball, shape: {type: sphere, radius: 0.3}, transform: {translation: [0, 0, 0.3]}}
+lights: [{type: constant, radiance: 0.5}]
+cameras: {cam: {model: opencv, size: [64, 48], fx: 50, dist: [-0.05, 0.01, 0, 0]}}
+views: [{camera: cam, orbit: {radius_m: 2, count: 3}}]
+"""
+
+
+@pytest.fixture(scope="module")
+def orbit(tmp_path_factory):
+    """A dataset rendered without a crossview: section (no tracks between views)."""
+    from scenegen.pipeline.run import render_spec
+
+    root = tmp_path_factory.mktemp("orbit")
+    (root / "orbit.yaml").write_text(NO_CROSSVIEW)
+    render_spec(root / "orbit.yaml", root / "out", progress=False)
+    return Dataset(root / "out")
+
+
 def run_export(ds, fmt, tmp_path, capsys=None):
     dest = tmp_path / fmt
     assert main(["export", str(ds.root), "--format", fmt, "-o", str(dest)]) == 0
@@ -80,6 +103,21 @@ def test_gaussian_splatting_layout_loads_in_pycolmap_with_3dgs_rules(ds, tmp_pat
             worst = max(worst, float(np.abs(im.points2D[el.point2D_idx].xy - ours).max()),
                         float(np.abs(im.project_point(p.xyz) - ours).max()))
     assert worst < 1e-9
+
+
+@pytest.mark.parametrize("fmt, folder", [("colmap", ""), ("gaussian-splatting", "sparse/0")])
+def test_models_without_crossview_truth_have_single_view_points(orbit, tmp_path, fmt, folder):
+    import pycolmap
+
+    rec = pycolmap.Reconstruction(str(run_export(orbit, fmt, tmp_path) / folder))
+    assert rec.num_images() == 3 and rec.num_cameras() == 1 and rec.num_points3D() > 50
+    for p in rec.points3D.values():
+        (el,) = p.track.elements  # observed in its own view only
+        im = rec.images[el.image_id]
+        xy = im.points2D[el.point2D_idx].xy
+        assert np.abs(im.project_point(p.xyz) - xy).max() < 1e-9
+        if fmt == "colmap":  # the real camera: the point is the truth of a grid pixel centre
+            assert np.abs(xy - 0.5 - np.round((xy - 0.5) / 8) * 8).max() < 1e-3
 
 
 def _distort_opencv(x, y, k1, k2, k3, k4, p1, p2):
