@@ -91,7 +91,7 @@ def test_gaussian_splatting_layout_loads_in_pycolmap_with_3dgs_rules(ds, tmp_pat
         ref = cv2.remap(cv2.imread(str(ds.path(f"images/{im.name}")), cv2.IMREAD_UNCHANGED), m1, m2, cv2.INTER_LINEAR)
         inner = (slice(4, -4), slice(4, -4))
         diff = np.abs(img[inner].astype(int) - ref[inner].astype(int))
-        assert diff.max() <= 1 and diff.mean() < 0.05
+        assert diff.max() <= 1 and diff.mean() < 0.01  # measured: identical (max 0)
     worst = 0.0
     for p in rec.points3D.values():
         assert p.track.length() >= 2
@@ -175,7 +175,7 @@ def test_nerf_transforms_by_the_consumer_rules(ds, tmp_path, capsys):
         u, vv = fl_x * xd + cx, fl_y * yd + cy
         worst_px = max(worst_px, float(np.abs(u - (ii[sel] + 0.5)).max()), float(np.abs(vv - (jj[sel] + 0.5)).max()))
     print(f"transforms.json: reprojection {worst_px:.2e} px, depth {worst_mm:.3f} mm")
-    assert worst_px < 2e-3 and worst_mm <= 0.5 + 1e-3
+    assert worst_px < 1e-4 and worst_mm <= 0.5 + 1e-3  # measured 5.4e-6 px (float32 truth points), 0.500 mm
 
 
 def _pykitti_calib(path):
@@ -207,7 +207,7 @@ def test_kitti_calib_cam_to_cam_and_obj_map(ds, tmp_path):
         x = P["02"] @ np.c_[(R_rect_00 @ pl.apply(X).T).T, np.ones(len(X))].T
         uv = (x[:2] / x[2]).T
         ref = fr.camera.project(fr.cam_from_world("left").apply(X))
-        assert np.abs(uv - ref).max() < 1e-6
+        assert np.abs(uv - ref).max() < 1e-9  # measured 5.8e-12
         # T_03: the right camera in the frame of camera 00
         R03, T03 = cal["R_03"].reshape(3, 3), cal["T_03"]
         assert np.allclose(R03 @ pl.apply(X).T + T03[:, None], pr.apply(X).T, atol=1e-9)
