@@ -5,7 +5,8 @@ Pictures, not truth: each tile is resized (nearest neighbour for ids, area avera
 rest) to ``tile_width`` pixels. Colours:
 
 * depth: ``depth_z`` mapped through OpenCV's TURBO colour map, near = red, far = blue, over the
-  view's own [min, max] of valid depth (the range is written under the row); black = no surface;
+  view's own [min, max] of valid depth (written in the row's caption), a span of at least
+  ``MIN_DEPTH_SPAN`` of the far depth (a frontal plane stays one colour); black = no surface;
 * normals: camera-frame unit normals as RGB = (n + 1) / 2 (x right = red, y down = green,
   z forward = blue); black = no surface;
 * ids: one colour per instance id (a fixed hash, the same in every view); black = 0 (none).
@@ -21,6 +22,7 @@ from scenegen.geometry.color import to_uint8
 
 KINDS = ("image", "depth", "normals", "ids")
 LABEL_PX = 18  # height of the text strip above each row
+MIN_DEPTH_SPAN = 0.05  # smallest colour-map span, as a fraction of the far depth
 GAP_PX = 2
 
 
@@ -37,7 +39,8 @@ def depth_tile(depth_z, valid) -> tuple[np.ndarray, tuple[float, float] | None]:
         return np.zeros(d.shape + (3,), np.uint8), None
     lo, hi = float(d[ok].min()), float(d[ok].max())
     t = np.zeros(d.shape)
-    t[ok] = (d[ok] - lo) / (hi - lo) if hi > lo else 0.0
+    span = max(hi - lo, MIN_DEPTH_SPAN * abs(hi))
+    t[ok] = (d[ok] - lo) / span if span > 0 else 0.0
     bgr = cv2.applyColorMap(np.rint(255 * (1 - t)).astype(np.uint8), cv2.COLORMAP_TURBO)
     rgb = bgr[..., ::-1].copy()
     rgb[~ok] = 0
