@@ -38,6 +38,16 @@ def test_the_wheel_holds_the_scenes_and_gates(tmp_path):
         assert want and want <= names, sorted(want - names)
     assert "scenegen/examples/scenes/demo.yaml" in names and "scenegen/examples/gates/geometry.yaml" in names
     assert "scenegen/bundled.py" in names and "recon_eval/cli/__init__.py" in names
+    # installed, the examples are found where the package is (not in this checkout)
+    site = tmp_path / "site"
+    r = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-3000:]
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); import scenegen.bundled as b; "
+            "f = b.example_files(); assert all(p.startswith(sys.argv[1]) for _, p in f), f; print(len(f))")
+    r = subprocess.run([sys.executable, "-c", code, str(site)], capture_output=True, text=True, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert int(r.stdout) == len(list((ROOT / "scenes").rglob("*.yaml"))) + len(list((ROOT / "gates").rglob("*.yaml")))
 
 
 def test_examples_are_found_and_copied(tmp_path, capsys):
