@@ -84,7 +84,7 @@ def bench_rss(folder: Path, frames: int) -> None:
     early = [r for _, r, d in samples if 50 <= d <= 100]
     late = [r for _, r, d in samples if d >= frames - 100]
     print(f"RSS over {s.views_rendered} frames (64x48, 4 spp, full pipeline, one process): "
-          f"{dt:.1f} s ({s.views_rendered / dt:.1f} frames/s)")
+          f"{dt:.1f} s ({s.views_rendered / dt:.1f} views/s)")
     if early and late:
         print(f"  RSS at frames 50-100: {min(early):.0f}-{max(early):.0f} MB; at the last 100: "
               f"{min(late):.0f}-{max(late):.0f} MB; drift {max(late) - max(early):+.1f} MB; peak (ru_maxrss) {peak:.0f} MB")
@@ -220,7 +220,7 @@ def bench_throughput(folder: Path, frames: int, w: int, h: int, spp: int) -> Non
     t = time.perf_counter()
     s = render_spec(spec, folder / "serial", progress=False)
     serial = s.views_rendered / (time.perf_counter() - t)
-    print(f"  this process (serial):   {serial:6.2f} frames/s")
+    print(f"  this process (serial):   {serial:6.2f} views/s")
     results = {}
     for n in (1, 2):
         t0 = time.perf_counter()
@@ -234,7 +234,7 @@ def bench_throughput(folder: Path, frames: int, w: int, h: int, spp: int) -> Non
             warm = time.perf_counter() - t
         results[n] = frames / warm
         print(f"  {n} Dask worker(s): cluster start {t_start:.1f} s; first run {cold:.1f} s "
-              f"(scene load + kernel compile per worker); warm {frames / warm:6.2f} frames/s "
+              f"(scene load + kernel compile per worker); warm {frames / warm:6.2f} views/s "
               f"({results[n] / serial:.2f}x serial)")
     print(f"  2 vs 1 workers: {results[2] / results[1]:.2f}x")
 

@@ -108,7 +108,8 @@ def pnp_arguments(p) -> None:
     p.add_argument("--view", help="dataset truth: the view (required when the dataset has several)")
     p.add_argument("--est-convention", choices=["cam_from_world", "world_from_cam"], default="cam_from_world",
                    help="what a bare matrix in EST holds (default: OpenCV solvePnP's cam_from_world)")
-    p.add_argument("--gt-convention", choices=["cam_from_world", "world_from_cam"], default="cam_from_world")
+    p.add_argument("--gt-convention", choices=["cam_from_world", "world_from_cam"], default="cam_from_world",
+                   help="how a truth pose file's R, t are meant (default cam_from_world: x_cam = R x_world + t)")
     p.add_argument("--points", type=int, default=5000, help="dataset truth: held-out truth points for reprojection")
     p.add_argument("--points-world", help="non-dataset truth: (N, 3) .npy world points for reprojection")
     p.add_argument("--pixels", help="non-dataset truth: (N, 2) .npy pixels observing them")

@@ -29,14 +29,26 @@ def needs_dataset_for_view(a) -> None:
         raise InputError(f"--view needs a dataset truth; {a.gt} is not a dataset folder")
 
 
-def stderr_progress(what: str, *, every_s: float = 2.0):
+#: How stderr_progress behaves in this process (set once by the command line: -q, -v).
+PROGRESS = {"enabled": True, "every_s": 2.0}
+
+
+def configure_progress(*, enabled: bool, every_s: float) -> None:
+    """-q turns the progress lines off; -v makes them more frequent."""
+    PROGRESS.update(enabled=enabled, every_s=every_s)
+
+
+def stderr_progress(what: str, *, every_s: float | None = None):
     """``progress(done, total)`` printing ``recon-eval: <what>: done/total`` on stderr at most every
-    ``every_s`` seconds, and the last line when the whole took longer than that (short runs print
-    nothing)."""
+    ``every_s`` seconds (default: the command line's), and the last line when the whole took longer
+    than that (short runs print nothing); a no-op under -q."""
+    every_s = PROGRESS["every_s"] if every_s is None else every_s
     start = last = time.monotonic()
 
     def progress(done: int, total: int) -> None:
         nonlocal last
+        if not PROGRESS["enabled"]:
+            return
         now = time.monotonic()
         if now - last >= every_s or (done >= total and now - start >= every_s):
             print(f"recon-eval: {what}: {done:,}/{total:,} ({100.0 * done / max(total, 1):.0f} %, "

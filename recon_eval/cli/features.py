@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from recon_eval.cli.common import stderr_progress
 from recon_eval.cli.scored import scored
 from recon_eval.metrics.features import REPEATABILITY_DEFINITIONS
 from recon_eval.readers.features import read_feature_files
@@ -42,7 +43,8 @@ def score(a):
     ds = read_dataset(a.dataset)
     pairs = select_pairs(ds, a.pairs)
     files = read_feature_files(a.result, [], pairs, a.pixel_origin)
-    ev = evaluate_features(ds, files.keypoints, files.matches, pairs, a.eps, a.repeatability)
+    ev = evaluate_features(ds, files.keypoints, files.matches, pairs, a.eps, a.repeatability,
+                           progress=stderr_progress("feature pairs"))
     inputs = {"result": a.result, "dataset": a.dataset, "eps_px": a.eps, "pixel_origin": a.pixel_origin,
               "repeatability_definition": a.repeatability,
               "pairs": [f"{i}:{j}" for i, j in pairs],

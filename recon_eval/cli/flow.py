@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from recon_eval.cli.common import stderr_progress
 from recon_eval.cli.scored import no_figures, scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.flow import flow_metrics
@@ -44,7 +45,9 @@ def _dataset_pairs(a, ds):
         pairs = [tuple(a.views)]
     fg_ids = [ds.object_id(n) for n in (a.fg_object or [])]
     out, missing = [], []
-    for i, j in pairs:
+    progress = stderr_progress("flow pairs")
+    for n, (i, j) in enumerate(pairs):
+        progress(n + 1, len(pairs))
         g, st, source = ds.flow_truth(i, j)
         if Path(a.est).is_dir():
             f = next((Path(a.est) / f"{i}__{j}{s}" for s in FLOW_SUFFIXES if (Path(a.est) / f"{i}__{j}{s}").is_file()),

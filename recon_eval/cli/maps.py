@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
+from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape, stderr_progress
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError, NotApplicable
 from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
@@ -35,7 +35,8 @@ def disparity_arguments(p) -> None:
     p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr; "
                                     "a Middlebury mask0nocc.png: 255 = evaluated)")
     p.add_argument("--obj-map", help="KITTI foreground map PNG")
-    p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti")
+    p.add_argument("--benchmark", choices=["kitti", "middlebury", "eth3d"], default="kitti",
+                   help="whose metrics: KITTI D1, Middlebury v3 bad-x/avgerr, ETH3D two-view (default kitti)")
     p.add_argument("--ndisp", type=float, help="Middlebury: clip estimates to [0, NDISP] as evaldisp does (default: "
                                                "ndisp of the calib.txt beside the truth file; for a dataset truth "
                                                "the export's max(16, 16 ceil(max d / 16)))")
@@ -164,7 +165,9 @@ def _dataset_depths(a, ds):
             ds.check_view(v)
         est_list, missing = [], []
         gt_list = [ds.depth(v) for v in views]
-        for v, g in zip(views, gt_list):
+        progress = stderr_progress("depth maps (views)")
+        for k, (v, g) in enumerate(zip(views, gt_list)):
+            progress(k + 1, len(views))
             f = find_view_map(a.est, v)
             if f is None:
                 missing.append(v)

@@ -123,7 +123,8 @@ def score_fmatrix(a):
 def homography_arguments(p) -> None:
     p.add_argument("h_est", help="estimated H (.txt/.npy/.json)")
     p.add_argument("h_gt", help="truth H (.txt/.npy/.json)")
-    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), required=True)
+    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), required=True,
+                   help="image size in pixels (the corners the homography is measured at)")
 
 
 def score_homography(a):

@@ -234,19 +234,26 @@ def summarise(scores, series: str, kind: str | None = None) -> SeriesSummary:
 
 
 def evaluate_features(ds, keypoints: dict, matches: dict, pairs, eps_px: float = DEFAULT_EPS_PX,
-                      repeatability_definition: str = REPEATABILITY_DEFINITIONS[0]) -> FeatureEvaluation:
+                      repeatability_definition: str = REPEATABILITY_DEFINITIONS[0],
+                      progress=None) -> FeatureEvaluation:
     """Score ``keypoints`` (view -> (N, 2) OpenCV px; a missing view has none) and ``matches``
-    ((i, j) -> (M, 2) int indices; a missing pair has none) on ``pairs`` of dataset ``ds``."""
+    ((i, j) -> (M, 2) int indices; a missing pair has none) on ``pairs`` of dataset ``ds``;
+    ``progress(done, total)`` after each pair."""
     if not eps_px > 0:
         raise InputError(f"eps_px must be > 0, got {eps_px}")
     scores = []
-    for i, j in pairs:
+    pairs = list(pairs)
+    for n, (i, j) in enumerate(pairs):
+        if progress is not None and n:
+            progress(n, len(pairs))
         map_ij, map_ji = correspondence_map(ds, i, j), correspondence_map(ds, j, i)
         desc = describe_pair(ds, i, j, map_ij)
         none = np.zeros((0, 2))
         scores.append(score_pair(keypoints.get(i, none), keypoints.get(j, none),
                                  matches.get((i, j), np.zeros((0, 2), np.int64)), map_ij, map_ji, desc, eps_px,
                                  repeatability_definition))
+    if progress is not None:
+        progress(len(pairs), len(pairs))
     by_series: dict = {}
     for s in scores:
         by_series.setdefault(s.description.series, []).append(s)

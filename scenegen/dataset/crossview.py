@@ -82,6 +82,29 @@ def decode_correspondence_channels(channels: Mapping[str, np.ndarray]) -> Corres
     return Correspondence(uv, np.asarray(channels["z"], np.float64), np.asarray(channels["state"]).astype(np.uint8))
 
 
+#: EXR channels of a rectification map (map_x, map_y: the raw pixel of each rectified pixel).
+#: Named R and G because OpenCV's EXR reader knows no other names: ``cv2.imread(path,
+#: cv2.IMREAD_UNCHANGED)`` (with OPENCV_IO_ENABLE_OPENEXR=1) gives BGR = (0, map_y, map_x).
+RECTIFICATION_MAP_CHANNELS = ("R", "G")
+#: The names written before the maps became OpenCV-readable (still read).
+_OLD_MAP_CHANNELS = ("map_x", "map_y")
+
+
+def encode_rectification_map(map_xy) -> dict[str, np.ndarray]:
+    """EXR channels of an (H, W, 2) map (x, y raw pixels), float32 R = map_x, G = map_y."""
+    m = np.asarray(map_xy)
+    return {name: m[..., k].astype(np.float32) for k, name in enumerate(RECTIFICATION_MAP_CHANNELS)}
+
+
+def decode_rectification_map(channels: Mapping[str, np.ndarray]) -> np.ndarray:
+    """(H, W, 2) float32 map of :func:`encode_rectification_map`'s channels (or the older
+    ``map_x``, ``map_y``); KeyError naming what is missing."""
+    for names in (RECTIFICATION_MAP_CHANNELS, _OLD_MAP_CHANNELS):
+        if all(n in channels for n in names):
+            return np.stack([np.asarray(channels[n], np.float32) for n in names], axis=-1)
+    raise KeyError(f"rectification map channels {RECTIFICATION_MAP_CHANNELS} missing; have {sorted(channels)}")
+
+
 @dataclass(frozen=True, eq=False)
 class MatchSet:
     """Labelled putative matches of a pair: ``rows`` (N, 8) float64 in :data:`MATCH_COLUMNS` order."""

@@ -23,6 +23,7 @@ from scenegen.dataset.crossview import (
     MatchSet,
     check_match_rows,
     decode_correspondence_channels,
+    decode_rectification_map,
 )
 from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.layout import (
@@ -129,8 +130,11 @@ class StereoFrame:
 
     def rectification_map(self, side: str) -> np.ndarray:
         """(H, W, 2) float32 raw pixel of each rectified pixel (for cv2.remap)."""
-        ch = self._read("map", side, read_exr, "map")
-        return np.stack([ch["map_x"], ch["map_y"]], axis=-1)
+        return self._read("map", side, lambda p: decode_rectification_map(read_exr(p)), "rectification map")
+
+    def instance_ids(self, side: str) -> np.ndarray:
+        """(H, W) uint32 instance id of the surface each rectified pixel centre sees (0 = none)."""
+        return self._read("ids", side, read_exr, "ids")["instance_id"]
 
 
 class CrossviewTruth:

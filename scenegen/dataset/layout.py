@@ -49,7 +49,7 @@ CROSSVIEW_INDEX = f"{CROSSVIEW}/index.json"
 STEREO_FILES = {
     "image": "{side}.png", "linear": "{side}_linear.exr", "disparity_pfm": "disp_{side}.pfm",
     "disparity_occ": "disp_{side}_occ.png", "disparity_noc": "disp_{side}_noc.png",
-    "correspondence": "corr_{side}.exr", "map": "map_{side}.exr",
+    "correspondence": "corr_{side}.exr", "map": "map_{side}.exr", "ids": "ids_{side}.exr",
 }
 STEREO_CALIB = "calib.json"
 STEREO_SIDES = ("left", "right")

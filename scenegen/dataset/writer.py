@@ -184,8 +184,8 @@ class DatasetWriter:
                      for k in IDENTITY_KEYS if m[k] != identity[k]]
             if diffs:
                 raise DatasetMismatchError(
-                    f"cannot resume {self.root}: it was written by a different run\n  "
-                    + "\n  ".join(diffs) + "\nUse a new output directory.")
+                    f"cannot resume {self.root}: it was written by a different run ("
+                    + "; ".join(diffs) + "); use a new output directory")
             self._views = {v: {"status": e["status"], "files": list(e["files"])}
                            for v, e in m["views"].items()}
             self._files = dict(m["files"])
@@ -197,7 +197,7 @@ class DatasetWriter:
             if (self.root / MANIFEST_JOURNAL).is_file() and not has_manifest:
                 hint = f"it has a {MANIFEST_JOURNAL} but no {MANIFEST}: the manifest was removed"
             else:
-                hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
+                hint = "render again with --resume to finish it" if has_manifest else "it has no manifest"
             raise DatasetError(f"{self.root} is not empty ({hint}); use a new or empty directory")
         if resume and has_manifest and resumed_unchanged:
             self._manifest_sha = m["manifest_sha256"]  # no rewrite of a large manifest to the same bytes

@@ -5,24 +5,31 @@ files where a format needs them) and writes ``dest`` (a new or empty folder). No
 imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 
 * ``colmap``: COLMAP text model (cameras.txt, images.txt, points3D.txt) + images/;
-* ``nerf``: instant-ngp / nerfstudio ``transforms.json`` + images/;
-* ``kitti-stereo``: KITTI 2015 stereo layout from the rectified stereo frames;
-* ``middlebury``: Middlebury v3 folders (im0/im1.png, disp0/disp1.pfm, calib.txt);
+* ``gaussian-splatting``: 3DGS scene folder (undistorted PINHOLE images/, sparse/0/);
+* ``nerf``: instant-ngp / nerfstudio ``transforms.json`` + images/, depth/, masks/, a split;
+* ``kitti-stereo``: KITTI 2015 stereo layout from the rectified stereo frames (calib, obj_map);
+* ``middlebury``: MiddEval3 folders (im0/im1.png, disp0GT/disp1GT.pfm, mask0nocc.png, calib.txt);
 * ``opencv``: cv2.FileStorage YAML (K, D, R, T per view; K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q per
   stereo frame; R T E F per cross-view pair);
-* ``tum``: TUM RGB-D trajectories, one file per camera stream.
+* ``tum``: TUM RGB-D trajectories and per stream rgb/, depth/ (x5000), rgb.txt, depth.txt,
+  groundtruth.txt, associations.txt.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from scenegen.export import colmap, kitti_stereo, middlebury, nerf, opencv_yaml, tum
-from scenegen.export.common import open_dataset, prepare_dest
+from scenegen.export import colmap, gaussian_splatting, kitti_stereo, middlebury, nerf, opencv_yaml, tum
+from scenegen.export.common import open_dataset, staged_dest
 from scenegen.export.errors import ExportError
 
-#: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
-FORMATS = {"colmap": colmap.export, "nerf": nerf.export, "kitti-stereo": kitti_stereo.export,
-           "middlebury": middlebury.export, "opencv": opencv_yaml.export, "tum": tum.export}
+#: Format name -> its exporter ``export(dataset, dest, progress=None) -> summary dict``
+#: (``progress(done, total)`` after each view, stereo frame or reference view).
+FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
+           "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
+           "tum": tum.export}
+#: What each exporter's progress counts.
+PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
+                  "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:
@@ -31,14 +38,15 @@ def default_dest(out_dir, fmt: str) -> Path:
     return p.parent / f"{p.name}.{fmt}"
 
 
-def export(out_dir, fmt: str, dest=None) -> dict:
+def export(out_dir, fmt: str, dest=None, progress=None) -> dict:
     """Export dataset ``out_dir`` as ``fmt`` into ``dest`` (default :func:`default_dest`);
-    returns a summary dict ``{"dest": ..., "files": n, ...}``."""
+    returns a summary dict ``{"dest": ..., "files": n, ...}``; ``progress(done, total)``
+    is called as the exporter goes (views, stereo frames or reference views)."""
     if fmt not in FORMATS:
         raise ExportError(f"unknown export format {fmt!r}; choose one of {', '.join(FORMATS)}")
     ds = open_dataset(out_dir)
     dest = Path(dest) if dest is not None else default_dest(out_dir, fmt)
-    prepare_dest(dest)
-    summary = FORMATS[fmt](ds, dest)
+    with staged_dest(dest) as stage:  # a refused export leaves no folder behind
+        summary = FORMATS[fmt](ds, stage, progress)
     summary["dest"] = str(dest)
     return summary

@@ -2,7 +2,12 @@
 atomic writes, float text."""
 from __future__ import annotations
 
+import os
+import shutil
+from contextlib import contextmanager
 from pathlib import Path
+
+import numpy as np
 
 from scenegen.dataset import Dataset, DatasetError
 from scenegen.dataset.files import atomic_write_bytes
@@ -23,10 +28,36 @@ def open_dataset(out_dir) -> Dataset:
     return ds
 
 
-def prepare_dest(dest: Path) -> None:
+def check_dest(dest: Path) -> None:
     if dest.exists() and (not dest.is_dir() or any(dest.iterdir())):
         raise ExportError(f"export destination {dest} exists and is not an empty folder; choose a new one with -o")
-    dest.mkdir(parents=True, exist_ok=True)
+
+
+@contextmanager
+def staged_dest(dest: Path):
+    """Yield a fresh sibling folder ``.<name>.partial-<pid>`` to write the export into; renamed to
+    ``dest`` when the block ends normally, removed when it raises: a refused or failed export
+    leaves nothing behind (an empty ``dest`` that existed before stays as it was)."""
+    check_dest(dest)
+    created = [p for p in reversed(dest.parents) if not p.exists()]  # outermost first
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    stage = dest.parent / f".{dest.name}.partial-{os.getpid()}"
+    if stage.exists():
+        shutil.rmtree(stage)
+    stage.mkdir()
+    try:
+        yield stage
+        check_dest(dest)  # nothing appeared there meanwhile
+        if dest.exists():
+            dest.rmdir()
+        stage.rename(dest)
+    except BaseException:
+        if stage.exists():
+            shutil.rmtree(stage)
+        for p in reversed(created):  # the folders made for it, innermost first, if still empty
+            if p.is_dir() and not any(p.iterdir()):
+                p.rmdir()
+        raise
 
 
 def name(kind: str, value: str) -> str:
@@ -61,3 +92,22 @@ def stereo_frames(ds):
 def fmt(x: float) -> str:
     """Shortest round-trip text of a float (a float64 read back is bit-identical)."""
     return repr(float(x))
+
+
+def depth_png16(depth_z, valid, units_per_m: float) -> tuple[np.ndarray, int]:
+    """(H, W) uint16 ``round(depth_z * units_per_m)`` (1000: millimetres, nerfstudio; 5000: TUM
+    RGB-D), 0 where there is no surface or the value does not fit in 16 bits; and the number of
+    surface pixels that did not fit (beyond 65535 / units_per_m metres)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        q = np.rint(np.where(valid, depth_z, 0.0).astype(np.float64) * units_per_m)
+    fits = valid & (q >= 1) & (q <= 65535)
+    return np.where(fits, q, 0).astype(np.uint16), int(np.count_nonzero(valid & ~fits))
+
+
+def each(items, progress=None):
+    """The items, calling ``progress(done, total)`` after each (when given)."""
+    items = list(items)
+    for k, item in enumerate(items):
+        yield item
+        if progress is not None:
+            progress(k + 1, len(items))

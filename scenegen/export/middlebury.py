@@ -1,10 +1,12 @@
-"""Middlebury stereo v3 layout, one folder per rectified stereo frame (named after its left view):
-``im0.png``, ``im1.png`` (rectified left/right), ``disp0.pfm``, ``disp1.pfm`` (float32 PFM,
-bottom row first, +inf = unknown; d = u_left - u_right), ``mask0nocc.png`` (255 = visible in
-the right view, 128 = occluded or out of frame, 0 = no surface) and ``calib.txt``:
-``cam0``, ``cam1`` (3x3, pixels), ``doffs`` (cx1 - cx0 = 0: both rectified views share cx),
-``baseline`` (MILLIMETRES, Middlebury's unit), ``width``, ``height``, ``ndisp``, ``isint``,
-``vmin``, ``vmax``. Disparity relates to depth by Z = baseline * f / (d + doffs).
+"""Middlebury stereo v3 in MiddEval3's layout and names: ``trainingF/<left view>/`` per rectified
+stereo frame (F: full resolution, the only one we have), as the MiddEval3 SDK's ``runeval``
+walks it: ``im0.png``, ``im1.png`` (rectified left/right), ``disp0GT.pfm``, ``disp1GT.pfm``
+(float32 PFM, bottom row first, +inf = unknown; d = u_left - u_right), ``mask0nocc.png`` and
+``mask1nocc.png`` (255 = visible in the other view, 128 = occluded or out of frame, 0 = no
+surface) and ``calib.txt``: ``cam0``, ``cam1`` (3x3, pixels), ``doffs`` (cx1 - cx0 = 0: both
+rectified views share cx), ``baseline`` (MILLIMETRES, Middlebury's unit), ``width``, ``height``,
+``ndisp``, ``isint``, ``vmin``, ``vmax``, ``dyavg``, ``dymax`` (0: exact rectification).
+Disparity relates to depth by Z = baseline * f / (d + doffs).
 """
 from __future__ import annotations
 
@@ -16,7 +18,9 @@ import numpy as np
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.crossview import VISIBLE
 from scenegen.dataset.layout import stereo_path
-from scenegen.export.common import stereo_frames, write
+from scenegen.export.common import each, stereo_frames, write
+
+TRAINING = "trainingF"
 
 
 def _mat(K) -> str:
@@ -24,27 +28,30 @@ def _mat(K) -> str:
     return "[" + "; ".join(" ".join(repr(float(x)) for x in row) for row in K) + "]"
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     frames = stereo_frames(ds)
-    for fr in frames:
-        name = fr.left_view  # a checked view name
+    for fr in each(frames, progress):
+        name = f"{TRAINING}/{fr.left_view}"  # a checked view name
         (dest / name).mkdir(parents=True, exist_ok=True)
         for key, side, dst in (("image", "left", "im0.png"), ("image", "right", "im1.png"),
-                               ("disparity_pfm", "left", "disp0.pfm"), ("disparity_pfm", "right", "disp1.pfm")):
-            shutil.copyfile(ds.path(stereo_path(name, key, side)), dest / name / dst)
+                               ("disparity_pfm", "left", "disp0GT.pfm"), ("disparity_pfm", "right", "disp1GT.pfm")):
+            shutil.copyfile(ds.path(stereo_path(fr.left_view, key, side)), dest / name / dst)
         calib = fr.calib
+        for k, side in enumerate(("left", "right")):
+            d = fr.disparity(side)
+            state = fr.correspondence(side).state
+            mask = np.where(state == VISIBLE, 255, np.where(np.isfinite(d), 128, 0)).astype(np.uint8)
+            write(dest, f"{name}/mask{k}nocc.png", encode_png(mask))
         d0 = fr.disparity("left")
-        state = fr.correspondence("left").state
-        mask = np.where(state == VISIBLE, 255, np.where(np.isfinite(d0), 128, 0)).astype(np.uint8)
-        write(dest, f"{name}/mask0nocc.png", encode_png(mask))
         fin = d0[np.isfinite(d0)]
         vmin, vmax = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 0.0)
         W, H = calib["size"]
         text = (f"cam0={_mat(calib['K'])}\ncam1={_mat(calib['K'])}\ndoffs=0\n"
                 f"baseline={repr(calib['baseline_m'] * 1000.0)}\nwidth={W}\nheight={H}\n"
-                f"ndisp={max(16, 16 * math.ceil(vmax / 16))}\nisint=0\nvmin={repr(vmin)}\nvmax={repr(vmax)}\n")
+                f"ndisp={max(16, 16 * math.ceil(vmax / 16))}\nisint=0\nvmin={repr(vmin)}\nvmax={repr(vmax)}\n"
+                "dyavg=0\ndymax=0\n")
         write(dest, f"{name}/calib.txt", text.encode())
-    return {"files": 6 * len(frames), "frames": len(frames)}
+    return {"files": 7 * len(frames), "frames": len(frames)}
 
 
 def read_calib(text: str) -> dict:

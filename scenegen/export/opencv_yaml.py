@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from scenegen.dataset.cameras import camera_of
-from scenegen.export.common import write
+from scenegen.export.common import each, write
 from scenegen.geometry.twoview import TwoView
 
 
@@ -28,10 +28,10 @@ def _F_opencv(F):
     return F / F[2, 2] if abs(F[2, 2]) > 1e-12 * np.linalg.norm(F) else F
 
 
-def export(ds, dest) -> dict:
+def export(ds, dest, progress=None) -> dict:
     fs = _fs()
     fs.startWriteStruct("views", cv2.FILE_NODE_SEQ)
-    for v in ds.views:
+    for v in each(ds.views, progress):
         cam, pose = ds.camera(v)
         K, D = cam.to_opencv()
         fs.startWriteStruct("", cv2.FILE_NODE_MAP)

@@ -43,6 +43,7 @@ from scenegen.dataset.layout import (
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
+from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.stereo import write_stereo_frame
 from scenegen.pipeline.view import view_truth
 
@@ -143,11 +144,14 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
     return entry
 
 
-def run_crossview(spec, views, built, writer, *, spp: int, seed: int) -> CrossviewSummary | None:
+def run_crossview(spec, views, built, writer, *, spp: int, seed: int,
+                  progress: bool = False) -> CrossviewSummary | None:
     """Write the cross-view truth ``spec.crossview`` asks for (nothing when it is None).
 
     ``views``: the resolved views; ``built``: the loaded scene (:class:`scenegen.render.scene.LoadedScene`);
-    ``writer``: the open DatasetWriter; ``spp``, ``seed``: render settings (rectified renders).
+    ``writer``: the open DatasetWriter; ``spp``, ``seed``: render settings (rectified renders);
+    ``progress``: a bar on stderr counting the stage's items (view pairs, flow pairs, stereo
+    frames, views with board truth).
     """
     cfg = getattr(spec, "crossview", None)
     if cfg is None:
@@ -156,29 +160,36 @@ def run_crossview(spec, views, built, writer, *, spp: int, seed: int) -> Crossvi
     ctx = _Context(spec, done, built, writer)
     names = set(ctx.views)
     pairs = [p for p in select_pairs(cfg.pairs, views) if p[0] in names and p[1] in names]
+    flows = [(va, vb) for vs in streams(views).values() for va, vb in zip(vs, vs[1:])
+             if va.name in names and vb.name in names] if cfg.flow else []  # adjacent frames of the
+    # full stream, both complete: stable across --frames runs
+    stereo = list(stereo_frames(done, spec.rigs)) if cfg.stereo else []
+    targets = done if cfg.targets and built.boards else []
     index = {"format": INDEX_FORMAT, "format_version": INDEX_FORMAT_VERSION,
              "occlusion_rel_tol": OCCLUSION_REL_TOL,
              "state_codes": {str(k): v for k, v in STATE_NAMES.items()},
              "match_columns": list(MATCH_COLUMNS), "match_labels": {str(k): v for k, v in LABELS.items()},
-             "pairs": [_pair(ctx, cfg, a, b) for a, b in pairs], "flow": [], "stereo": [], "targets": []}
-    if cfg.flow:  # adjacent frames of the full stream, both complete: stable across --frames runs
-        for vs in streams(views).values():
-            for va, vb in zip(vs, vs[1:]):
-                if va.name not in names or vb.name not in names:
-                    continue
-                for i, j in ((va.name, vb.name), (vb.name, va.name)):
-                    ctx.write(flow_path(i, j), encode_flo(flow_field(ctx.corr(i, j))))
-                index["flow"].append({"i": va.name, "j": vb.name})
-    if cfg.stereo:
-        for left, right in stereo_frames(done, spec.rigs):
+             "pairs": [], "flow": [], "stereo": [], "targets": []}
+    total = len(pairs) + len(flows) + len(stereo) + len(targets)
+    with ViewProgress(progress, total, label="cross-view truth", unit="items") as bar:
+        for a, b in pairs:
+            index["pairs"].append(_pair(ctx, cfg, a, b))
+            bar.advance()
+        for va, vb in flows:
+            for i, j in ((va.name, vb.name), (vb.name, va.name)):
+                ctx.write(flow_path(i, j), encode_flo(flow_field(ctx.corr(i, j))))
+            index["flow"].append({"i": va.name, "j": vb.name})
+            bar.advance()
+        for left, right in stereo:
             index["stereo"].append(write_stereo_frame(ctx, left, right, spp=spp, seed=seed))
-    if cfg.targets and built.boards:
-        for v in done:
+            bar.advance()
+        for v in targets:
             cam, pose = ctx.camera(v.name)
             boards = {name: board_view_truth(board, wfb, cam, pose, built.visible_from)
                       for name, (board, wfb) in built.boards.items()}
             ctx.write(view_targets_path(v.name), encode_json({"view": v.name, "boards": boards}))
             index["targets"].append(v.name)
+            bar.advance()
     index["files"] = sorted(ctx.files)
     if len(done) == len(views):  # the index describes the whole run; partial runs write none
         writer.write_file(CROSSVIEW_INDEX, encode_json(index))

@@ -18,7 +18,7 @@ from scenegen.dataset.writer import DatasetWriter, software_versions
 from scenegen.imaging.stage import imaging_record, raw_view_record
 from scenegen.pipeline.crossview import run_crossview
 from scenegen.pipeline.distributed import render_views_dask
-from scenegen.pipeline.progress import FrameProgress
+from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
@@ -128,7 +128,7 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     pending = [(index, v) for index, v in todo if not writer.is_complete(v.name)]
     skipped = len(todo) - len(pending)
     rendered = 0
-    with FrameProgress(progress, len(todo)) as bar:
+    with ViewProgress(progress, len(todo)) as bar:
         for _ in range(skipped):
             bar.advance()
         if dask_client is not None:  # workers render and write; recorded here in the run's order
@@ -143,6 +143,6 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                     del image, linear, truth, extra  # the writer holds the only references
                     rendered += 1
                     bar.advance()
-    run_crossview(spec, views, built, writer, spp=spp, seed=seed)  # cross-view truth (docs/crossview.md)
+    run_crossview(spec, views, built, writer, spp=spp, seed=seed, progress=progress)  # docs/crossview.md
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)

@@ -18,9 +18,9 @@ from scenegen.dataset.codecs import (
     encode_png,
     pack_channels,
 )
-from scenegen.dataset.crossview import VISIBLE, encode_correspondence_channels
+from scenegen.dataset.crossview import VISIBLE, encode_correspondence_channels, encode_rectification_map
 from scenegen.dataset.layout import STEREO_SIDES, stereo_dir, stereo_path
-from scenegen.dataset.truth import LINEAR_CHANNELS
+from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_ID_KEYS
 from scenegen.geometry.color import srgb_image
 from scenegen.geometry.rectify import disparity_from_depth, rectification_map, rectify
 from scenegen.geometry.seeds import hashed_seed32
@@ -42,6 +42,7 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
         ctx.write(stereo_path(left, "image", side), encode_png(srgb_image(lin, ctx.spec.render.bit_depth)))
         ctx.write(stereo_path(left, "linear", side), encode_exr(pack_channels("", lin, LINEAR_CHANNELS)))
         t = built.truth(rc, pose)
+        ctx.write(stereo_path(left, "ids", side), encode_exr({k: t[k] for k in TRUTH_ID_KEYS}))
         truths[side] = (np.where(t["valid"][..., None], t["points_world"], np.nan), t["depth_z"])
     for side, other_pose in zip(STEREO_SIDES, (rect.cam_right_from_world, rect.cam_left_from_world)):
         pts, depth = truths[side]
@@ -53,8 +54,7 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
         ctx.write(stereo_path(left, "correspondence", side), encode_exr(encode_correspondence_channels(c)))
     for side, raw, R in zip(STEREO_SIDES, (cam_l, cam_r), (rect.R1, rect.R2)):
         mp = rectification_map(raw, R, rc)
-        ctx.write(stereo_path(left, "map", side), encode_exr(
-            {"map_x": mp[..., 0].astype(np.float32), "map_y": mp[..., 1].astype(np.float32)}))
+        ctx.write(stereo_path(left, "map", side), encode_exr(encode_rectification_map(mp)))
     calib = rect.to_dict()
     calib.update({"left_view": left, "right_view": right,
                   "raw_left": {"camera": cam_l.to_dict(), "cam_from_world": pose_l.to_dict()},

@@ -8,6 +8,7 @@ Without one, ``auto`` falls back to ``scalar_rgb`` with a warning.
 """
 from __future__ import annotations
 
+import contextlib
 import glob
 import os
 import re
@@ -101,10 +102,59 @@ def resolve_variant(requested: str = "auto") -> str:
     return requested
 
 
+#: Mitsuba's own log lines (warnings and errors): shown on stderr in our words (``scenegen:
+#: Mitsuba warning: [Plugin] message``, without its timestamp and colour codes), or, with
+#: ``show`` off (the CLI's -q), warnings dropped and errors still shown.
+RENDERER_LOG = {"show": True, "appender": None}
+_MITSUBA_PREFIX = re.compile(r"^\S+ \S+ +(?:WARN|ERROR|INFO|DEBUG|TRACE)\s+")
+
+
+def set_renderer_log(show: bool) -> None:
+    RENDERER_LOG["show"] = bool(show)
+
+
+@contextlib.contextmanager
+def renderer_log(show: bool):
+    """Mitsuba's warnings shown or not inside the block (restored after it)."""
+    before = RENDERER_LOG["show"]
+    set_renderer_log(show)
+    try:
+        yield
+    finally:
+        set_renderer_log(before)
+
+
+def renderer_log_line(level_name: str, text: str) -> str:
+    """Our wording of one Mitsuba log line."""
+    return f"scenegen: Mitsuba {level_name}: {_MITSUBA_PREFIX.sub('', text.strip())}"
+
+
+def _install_log(mi) -> None:
+    if RENDERER_LOG["appender"] is not None:
+        return
+
+    class Appender(mi.Appender):
+        def append(self, level, text):
+            error = level == mi.LogLevel.Error
+            if error or RENDERER_LOG["show"]:
+                print(renderer_log_line("error" if error else "warning", text), file=sys.stderr, flush=True)
+
+        def log_progress(self, *args):
+            pass
+
+    logger = mi.logger() if hasattr(mi, "logger") else mi.Thread.thread().logger()
+    appender = Appender()
+    logger.clear_appenders()
+    logger.add_appender(appender)
+    RENDERER_LOG["appender"] = appender  # kept alive here
+
+
 def load_mitsuba(variant: str = "auto"):
-    """Import Mitsuba with a safe libLLVM and the resolved variant set; returns the module."""
+    """Import Mitsuba with a safe libLLVM and the resolved variant set, its log lines in our
+    words (:data:`RENDERER_LOG`); returns the module."""
     resolved = resolve_variant(variant)
     import mitsuba as mi  # only now: after the libLLVM is chosen and the variant resolved
 
     mi.set_variant(resolved)
+    _install_log(mi)
     return mi

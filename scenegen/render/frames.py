@@ -8,6 +8,7 @@ import numpy as np
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.lights import set_lighting
 from scenegen.render.objects import place_moving_objects
+from scenegen.spec.model.render import effective_spp
 
 
 def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int,
@@ -30,7 +31,8 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
     shutter = getattr(optics, "shutter", None)
     exposure = 0.0 if shutter is None else shutter.exposure_s
     n_sub = built.motion_subframes if exposure > 0 else 1
-    sub_spp = max(1, int(spp) // n_sub)
+    # asked as the count the sampler takes (the same samples; no Mitsuba WARN about rounding)
+    sub_spp = effective_spp(built.sampler, max(1, int(spp) // n_sub))
     out = np.zeros((camera.height, camera.width, 3), np.float64)
     for k in range(n_sub):
         if n_sub > 1:
@@ -55,5 +57,5 @@ def render_ideal(built, sensor_camera_name: str, camera, cam_from_world: Rigid3,
     set_lighting(built, light_scales)
     sensor = built.sensors[sensor_camera_name]
     sensor.set_camera(camera, cam_from_world)
-    img = mi.render(built.scene, sensor=sensor, spp=int(spp), seed=int(seed))
+    img = mi.render(built.scene, sensor=sensor, spp=effective_spp(built.sampler, int(spp)), seed=int(seed))
     return np.array(img, dtype=np.float32)[..., :3]

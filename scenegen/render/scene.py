@@ -41,6 +41,7 @@ class LoadedScene:
     part_meshes: dict = field(default_factory=dict)  # scene-dict key -> world trimesh of one part
     # of a mesh rendered with its own materials
     alpha_masked: bool = False  # some surface has an alpha mask: truth rays test its opacity
+    sampler: str = "ldsampler"  # the sensors' Mitsuba sampler plugin (it rounds spp up: effective_spp)
 
     @property
     def variant(self) -> str:
@@ -82,7 +83,7 @@ def object_key(obj) -> str:
 def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) -> LoadedScene:
     """Load ``spec`` into Mitsuba (current variant) with one of our sensors per spec camera."""
     sensor_mod.register()
-    built = LoadedScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=())
+    built = LoadedScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=(), sampler=sampler)
     d: dict = {"type": "scene", "integrator": {"type": "path", "max_depth": int(max_depth)}}
     object_ids, instance_ids = {}, {}
     for obj in spec.objects:

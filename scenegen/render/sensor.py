@@ -19,6 +19,7 @@ from scenegen.geometry.camera import ALL_COEFFS, Camera, unproject_uv
 from scenegen.geometry.conventions import opencv_pixel_from_film
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.drjit_ops import DRJIT_OPS
+from scenegen.spec.model.render import effective_spp
 
 SENSOR_PLUGIN = "scenegen_camera"
 
@@ -160,7 +161,9 @@ def sensor_dict(camera: Camera, *, spp: int, sampler: str = "ldsampler", seed: i
         **({"shutter_open": 0.0, "shutter_close": 1.0} if timed else {}),
         "film": {"type": "hdrfilm", "width": camera.width, "height": camera.height,
                  "rfilter": {"type": "box"}, "pixel_format": pixel_format, "component_format": "float32"},
-        "sampler": {"type": sampler, "sample_count": int(spp), "seed": int(seed)},
+        # the count the sampler takes (it rounds up; asking for that count renders the same samples
+        # and keeps Mitsuba from logging a WARN line for the rounding)
+        "sampler": {"type": sampler, "sample_count": effective_spp(sampler, int(spp)), "seed": int(seed)},
     }
 
 

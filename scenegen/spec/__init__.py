@@ -20,11 +20,13 @@ from scenegen.spec.model import (
     Shape, Sphere, SpotLight, Target, Texture, Torus, Transform, View, ViewSet,
 )
 from scenegen.spec.serialize import canonical_json, spec_sha256, spec_to_dict
+from scenegen.spec.to_yaml import check_spec, same_spec, to_yaml
 from scenegen.spec.views import resolve_views
 
 __all__ = [
     "SpecError", "Where", "load_spec", "parse_spec", "resolve_views", "spec_to_dict",
-    "spec_sha256", "canonical_json", "derive_seed", "TOP_LEVEL_KEYS",
+    "spec_sha256", "canonical_json", "derive_seed", "TOP_LEVEL_KEYS", "to_yaml", "same_spec",
+    "check_spec",
     "AreaLight", "ArucoGridTarget", "Blob", "Box", "CameraSpec", "CharucoTarget",
     "CheckerboardTarget", "CirclePath", "ConductorMaterial", "ConstantLight", "Cylinder",
     "DiffuseMaterial", "EnvmapLight", "Light", "LinePath", "LookAt", "LookAtList", "Material",

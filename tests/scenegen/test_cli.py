@@ -14,6 +14,9 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_option_lists_are_the_projects():
     assert cli.RENDER_VARIANTS == RENDER_VARIANTS
     assert cli.EXPORT_FORMATS == tuple(FORMATS)
+    from scenegen.export import PROGRESS_UNITS
+
+    assert set(PROGRESS_UNITS) == set(FORMATS)
 
 
 def _modules_after(code: str) -> set[str]:

@@ -1,5 +1,5 @@
-"""Poses as written: translation + Euler angles or quaternion, or a 4x4 / 3x4 matrix; object
-transforms (pose + scale); aiming a light at a point."""
+"""Poses as written: translation + Euler angles or quaternion, or a 4x4 / 3x4 matrix (as a list
+of rows, or under ``matrix:``); object transforms (pose + scale); aiming a light at a point."""
 from __future__ import annotations
 
 import numpy as np
@@ -15,7 +15,7 @@ from scenegen.spec.parse.read import read_floats
 DEFAULT_EULER_ORDER = "xyz"
 #: Translation when `translation` is absent.
 ORIGIN = (0.0, 0.0, 0.0)
-POSE_KEYS = ("translation", "rotation_deg", "rotation_quat_wxyz", "order")
+POSE_KEYS = ("translation", "rotation_deg", "rotation_quat_wxyz", "order", "matrix")
 
 
 def parse_transform(node: Node) -> Transform:
@@ -35,7 +35,13 @@ def parse_transform(node: Node) -> Transform:
 
 
 def parse_rigid(f: Fields) -> Rigid3:
-    """translation + rotation_deg (with order) | rotation_quat_wxyz, from checked fields."""
+    """translation + rotation_deg (with order) | rotation_quat_wxyz, or ``matrix`` (4x4 / 3x4
+    rows, bit-exact: what :func:`scenegen.spec.to_yaml.to_yaml` writes), from checked fields."""
+    if "matrix" in f:
+        others = [k for k in POSE_KEYS if k != "matrix" and k in f]
+        if others:
+            raise f.get(others[0]).error(f"give either 'matrix' or {others[0]!r}, not both")
+        return matrix_pose(f.get("matrix"))
     t = f.vec3("translation", ORIGIN)
     which = f.one_of(("rotation_deg", "rotation_quat_wxyz"), required=False)
     if "order" in f and which != "rotation_deg":
@@ -69,19 +75,24 @@ def parse_euler_order(node: Node | None) -> str:
 def parse_pose(node: Node) -> Rigid3:
     """A pose given as a 4x4 / 3x4 matrix or as translation + rotation."""
     if node.is_sequence:
-        rows = node.items()
-        if len(rows) not in (3, 4):
-            raise node.error(f"expected a 4x4 (or 3x4) matrix as a list of rows, got "
-                             f"{len(rows)} rows")
-        T = np.array([r.as_floats(4) for r in rows])
-        try:
-            return Rigid3.from_matrix(T)
-        except ValueError as e:
-            raise node.error(f"expected a rigid transform: {e}") from None
+        return matrix_pose(node)
     f = node.as_mapping("a pose: a 4x4 matrix, or a mapping with translation and "
                         "rotation_deg or rotation_quat_wxyz")
     f.check(optional=POSE_KEYS)
     return parse_rigid(f)
+
+
+def matrix_pose(node: Node) -> Rigid3:
+    """A rigid 4x4 (or 3x4) matrix given as a list of rows."""
+    rows = node.items("a 4x4 (or 3x4) matrix as a list of rows")
+    if len(rows) not in (3, 4):
+        raise node.error(f"expected a 4x4 (or 3x4) matrix as a list of rows, got "
+                         f"{len(rows)} rows")
+    T = np.array([r.as_floats(4) for r in rows])
+    try:
+        return Rigid3.from_matrix(T)
+    except ValueError as e:
+        raise node.error(f"expected a rigid transform: {e}") from None
 
 
 def aim(position, target, up, node: Node) -> Rigid3:

@@ -218,7 +218,7 @@ class TestResume:
 
     def test_non_empty_dir_without_resume_refused(self, tmp_path):
         write_dataset(tmp_path / "b", views=VIEWS[:1])
-        with pytest.raises(ds.DatasetError, match="resume=True"):
+        with pytest.raises(ds.DatasetError, match="render again with --resume"):
             new_writer(tmp_path / "b")
         (tmp_path / "c").mkdir()
         (tmp_path / "c" / "notes.txt").write_text("mine")

@@ -110,10 +110,8 @@ def test_middlebury_export_round_trips(ds, tmp_path):
 
     dest = run_export(ds, "middlebury", tmp_path)
     fr = sio.read_json(ds.path("crossview/index.json"))["stereo"][0]
-    folder = dest / fr["left_view"]
-    assert sorted(p.name for p in folder.iterdir()) == ["calib.txt", "disp0.pfm", "disp1.pfm", "im0.png", "im1.png",
-                                                        "mask0nocc.png"]
-    d0 = decode_pfm((folder / "disp0.pfm").read_bytes())
+    folder = dest / "trainingF" / fr["left_view"]
+    d0 = decode_pfm((folder / "disp0GT.pfm").read_bytes())
     assert np.array_equal(d0, decode_pfm(ds.path(f"{fr['dir']}/disp_left.pfm").read_bytes()), equal_nan=True)
     cal = read_calib((folder / "calib.txt").read_text())
     assert cal["baseline"] == pytest.approx(120.0, rel=1e-12)

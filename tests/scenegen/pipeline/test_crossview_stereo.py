@@ -74,8 +74,8 @@ def test_rectification_maps_resample_raw_to_rectified(ds):
     fr = frames(ds)[0]
     base = fr["dir"]
     raw = ds.linear_image(fr["left_view"])
-    m = sio.read_exr(ds.path(f"{base}/map_left.exr"))
-    warped = cv2.remap(raw, m["map_x"], m["map_y"], cv2.INTER_LINEAR, borderValue=np.nan)
+    m = sio.read_exr(ds.path(f"{base}/map_left.exr"))  # R = map_x, G = map_y (OpenCV-readable names)
+    warped = cv2.remap(raw, m["R"], m["G"], cv2.INTER_LINEAR, borderValue=np.nan)
     rect = sio.unpack_channels(sio.read_exr(ds.path(f"{base}/left_linear.exr")), "", "RGB")
     shifted_img = np.roll(warped, 1, axis=1)
     ok = np.isfinite(warped).all(-1) & np.isfinite(shifted_img).all(-1)
