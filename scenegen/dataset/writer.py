@@ -25,6 +25,7 @@ from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
 from scenegen.dataset.files import atomic_write_bytes, remove_stale_temp_files, sha256_bytes
 from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, check_view_name, mesh_path, view_paths
+from scenegen.dataset.lock import LOCK_NAME, DatasetLock
 from scenegen.dataset.manifest import (
     FORMAT,
     FORMAT_VERSION,
@@ -113,7 +114,8 @@ def software_versions() -> dict[str, str]:
 
 
 class DatasetWriter:
-    """Writes a dataset directory; owns its manifest (use one writer per directory).
+    """Writes a dataset directory; owns its manifest and, until :meth:`close`, the folder's lock
+    (:mod:`scenegen.dataset.lock`: a second writer on the folder fails naming this one).
 
     Typical use::
 
@@ -152,6 +154,7 @@ class DatasetWriter:
         self._files: dict[str, str] = {}  # relative path -> sha256
         self._view_order: list[str] = []
 
+        self._lock = DatasetLock.acquire(self.root)  # one writer per folder, before anything is touched
         has_manifest = (self.root / MANIFEST).is_file()
         if resume and self.root.is_dir():
             remove_stale_temp_files(self.root)
@@ -166,7 +169,7 @@ class DatasetWriter:
             self._views = {v: {"status": e["status"], "files": list(e["files"])}
                            for v, e in m["views"].items()}
             self._files = dict(m["files"])
-        elif self.root.exists() and any(self.root.iterdir()):
+        elif self.root.exists() and any(p.name != LOCK_NAME for p in self.root.iterdir()):
             hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
             raise DatasetError(f"{self.root} is not empty ({hint}); use a new or empty directory")
         self._write_manifest()
@@ -278,6 +281,7 @@ class DatasetWriter:
     def close(self) -> None:
         """Write the manifest a last time (every method already leaves it up to date)."""
         self._write_manifest()
+        self._lock.release()
 
     def __enter__(self) -> "DatasetWriter":
         return self
