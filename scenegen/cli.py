@@ -2,6 +2,10 @@
 
 Bad input (spec errors, bad options, unusable output folders) prints one clear message and exits
 with code 2, without a traceback.
+
+Each command imports what it needs when it runs (the renderer, the dataset codecs, the exports
+pull in Mitsuba, OpenCV, OpenEXR, trimesh, scipy): ``scenegen --help`` imports nothing but the
+standard library, and ``validate`` no more than the spec parser (docs/performance.md).
 """
 from __future__ import annotations
 
@@ -11,16 +15,13 @@ import sys
 import warnings
 from pathlib import Path
 
-from scenegen.dataset import Dataset, DatasetError, verify
 from scenegen.errors import SpecError
-from scenegen.export import FORMATS, export
-from scenegen.pipeline.batch import render_many
-from scenegen.pipeline.run import render_spec
-from scenegen.render import BackendError
-from scenegen.spec import load_spec, resolve_views
-from scenegen.spec.model import RENDER_VARIANTS
 
 EXIT_BAD_INPUT = 2
+#: ``--variant`` choices: scenegen.spec.model.RENDER_VARIANTS (equal, tests/scenegen/test_cli.py)
+RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
+#: ``export --format`` choices: scenegen.export.FORMATS (equal, tests/scenegen/test_cli.py)
+EXPORT_FORMATS = ("colmap", "nerf", "kitti-stereo", "middlebury", "opencv", "tum")
 
 
 def _err(msg: str) -> int:
@@ -35,6 +36,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def cmd_validate(args) -> int:
+    from scenegen.spec import load_spec, resolve_views  # the command's implementation, on use
+
     spec = load_spec(args.spec)
     views = resolve_views(spec)
     for name, cam in spec.cameras.items():
@@ -47,6 +50,9 @@ def cmd_validate(args) -> int:
 
 
 def cmd_render(args) -> int:
+    from scenegen.pipeline.batch import render_many  # the command's implementation, on use
+    from scenegen.pipeline.run import render_spec  # the command's implementation, on use
+
     many = args.variants is not None or args.workers is not None or args.scheduler is not None
     with warnings.catch_warnings():
         warnings.simplefilter("always")
@@ -72,6 +78,8 @@ def _print_summary(s) -> None:
 
 
 def cmd_info(args) -> int:
+    from scenegen.dataset import Dataset  # the command's implementation, on use
+
     d = Dataset(args.dataset)
     m = d.manifest
     print(f"{args.dataset}: {m['format']} v{m['format_version']}, variant {m['variant']}, seed {m['seed']}")
@@ -87,6 +95,8 @@ def cmd_info(args) -> int:
 
 
 def cmd_export(args) -> int:
+    from scenegen.export import export  # the command's implementation, on use
+
     s = export(args.dataset, args.format, args.output)
     extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
     print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
@@ -94,6 +104,8 @@ def cmd_export(args) -> int:
 
 
 def cmd_verify(args) -> int:
+    from scenegen.dataset import verify  # the command's implementation, on use
+
     r = verify(args.dataset)
     if args.json:
         print(json.dumps(r.__dict__, indent=2, default=list))
@@ -133,10 +145,20 @@ def build_parser() -> argparse.ArgumentParser:
     f.set_defaults(fn=cmd_verify)
     e = sub.add_parser("export", help="export a dataset to colmap, nerf, kitti-stereo, middlebury, opencv or tum")
     e.add_argument("dataset", type=Path)
-    e.add_argument("--format", required=True, choices=tuple(FORMATS))
+    e.add_argument("--format", required=True, choices=EXPORT_FORMATS)
     e.add_argument("-o", "--output", type=Path, help="destination folder (default: <dataset>.<format>)")
     e.set_defaults(fn=cmd_export)
     return p
+
+
+def _bad_input_errors() -> tuple[type, ...]:
+    """The exceptions that mean bad input. The dataset's and the renderer's are taken from
+    sys.modules: an error of a module this run never imported cannot have been raised."""
+    found = [ValueError, FileNotFoundError]
+    for module, name in (("scenegen.dataset.errors", "DatasetError"), ("scenegen.render.backend", "BackendError")):
+        if module in sys.modules:
+            found.append(getattr(sys.modules[module], name))
+    return tuple(found)
 
 
 def main(argv=None) -> int:
@@ -145,10 +167,12 @@ def main(argv=None) -> int:
         return args.fn(args)
     except SpecError as e:
         return _err(str(e))
-    except (DatasetError, BackendError, ValueError, FileNotFoundError) as e:
-        return _err(str(e))
-    except BrokenPipeError:  # output piped into e.g. `head`
-        return 0
+    except Exception as e:  # bad input is told apart here; anything else propagates
+        if isinstance(e, _bad_input_errors()):
+            return _err(str(e))
+        if isinstance(e, BrokenPipeError):  # output piped into e.g. `head`
+            return 0
+        raise
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from scenegen.assets import shapes, targets, textures
+from scenegen.assets import cache, shapes, targets, textures
 
 #: Spec geometry kind -> its object-frame mesh (all centred on the object origin).
 OBJECT_MESHES = {
@@ -18,7 +18,7 @@ OBJECT_MESHES = {
     "sphere": lambda g: shapes.sphere(g.radius),
     "cylinder": lambda g: shapes.cylinder(g.radius, g.height),
     "torus": lambda g: shapes.torus(g.major_radius, g.minor_radius),
-    "blob": lambda g: shapes.blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions),
+    "blob": lambda g: cached_blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions),
     "mesh": lambda g: shapes.load_mesh(g.path),
 }
 TARGET_KINDS = ("checkerboard", "charuco", "aruco_grid")
@@ -65,7 +65,24 @@ def is_smooth(geometry, object_mesh_: trimesh.Trimesh, world: trimesh.Trimesh) -
 
 
 def texture_image(texture) -> np.ndarray:
-    """Linear float32 (H, W, 3) reflectance of a spec texture (image file or procedural)."""
+    """Linear float32 (H, W, 3) reflectance of a spec texture (image file or procedural); a
+    procedural one is made once per content hash (:mod:`scenegen.assets.cache`), read-only."""
     if texture.kind == "image":
         return textures.load_image(texture.path)
-    return textures.make_texture(texture.kind, dict(texture.params), texture.seed)
+    params = dict(texture.params)
+    key = {"kind": texture.kind, "params": params, "seed": texture.seed}
+    make = lambda: {"image": textures.make_texture(texture.kind, params, texture.seed)}
+    return cache.cached_arrays("texture", key, make)["image"]
+
+
+def cached_blob(radius, amplitude, frequency, seed, subdivisions) -> trimesh.Trimesh:
+    """:func:`scenegen.assets.shapes.blob`, made once per content hash (:mod:`scenegen.assets.cache`)."""
+    def make():
+        m = shapes.blob(radius, amplitude, frequency, seed, subdivisions)
+        return {"vertices": m.vertices, "faces": m.faces, "uv": m.visual.uv}
+
+    key = {"radius": radius, "amplitude": amplitude, "frequency": frequency, "seed": seed,
+           "subdivisions": subdivisions}
+    a = cache.cached_arrays("blob", key, make)
+    return trimesh.Trimesh(vertices=a["vertices"].copy(), faces=a["faces"].copy(),
+                           visual=trimesh.visual.TextureVisuals(uv=a["uv"].copy()), process=False)

@@ -6,7 +6,8 @@ knows paths (docs/dataset_format.md, docs/crossview.md).
   PNG16, FLO, PLY);
 * :mod:`.files`: atomic writes and SHA-256;
 * :mod:`.manifest`, :mod:`.cameras`, :mod:`.truth`, :mod:`.crossview`: what each file holds;
-* :mod:`.writer`: :class:`DatasetWriter` (atomic, hashed, resumable);
+* :mod:`.writer`: :class:`DatasetWriter` (atomic, hashed, resumable), with :mod:`.journal`
+  (the manifest's append-only journal while a run writes);
 * :mod:`.reader` and :mod:`.crossview_reader`: :class:`Dataset`, typed access to everything;
 * :mod:`.verify`: re-hash a folder against its manifest.
 
@@ -14,6 +15,7 @@ Nothing here imports Mitsuba or Dr.Jit.
 """
 from scenegen.dataset.cameras import ViewCamera
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
+from scenegen.dataset.journal import load_current_manifest
 from scenegen.dataset.layout import CAMERAS, MANIFEST, mesh_path, view_paths
 from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION
 from scenegen.dataset.reader import Dataset
@@ -24,5 +26,5 @@ from scenegen.dataset.writer import DatasetWriter, encode_view, software_version
 __all__ = [
     "CAMERAS", "MANIFEST", "FORMAT", "FORMAT_VERSION", "TRUTH_KEYS", "DatasetError", "DatasetMismatchError",
     "ViewCamera", "view_paths", "mesh_path", "check_truth", "encode_view", "write_view_files",
-    "software_versions", "DatasetWriter", "Dataset", "VerifyReport", "verify",
+    "software_versions", "DatasetWriter", "Dataset", "VerifyReport", "verify", "load_current_manifest",
 ]

@@ -23,7 +23,7 @@ _HASH_CHUNK = 1 << 20  # bytes read at a time by sha256_file
 
 
 # --- atomic writes ----------------------------------------------------------------------------
-def _fsync_dir(directory: Path) -> None:
+def fsync_dir(directory: Path) -> None:
     """Make a rename in ``directory`` durable (no-op where directories cannot be opened)."""
     try:
         fd = os.open(directory, os.O_RDONLY)
@@ -61,13 +61,51 @@ def atomic_write(path, write_fn: Callable[[BinaryIO], None]) -> None:
         except FileNotFoundError:
             pass
         raise
-    _fsync_dir(path.parent)
+    fsync_dir(path.parent)
+
+
+def write_payload(f: BinaryIO, data: bytes) -> None:
+    """Write a file's bytes into its open temporary file (the one place every byte goes through)."""
+    f.write(data)
 
 
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` atomically (see :func:`atomic_write`)."""
     data = bytes(data) if not isinstance(data, bytes) else data
-    atomic_write(path, lambda f: f.write(data))
+    atomic_write(path, lambda f: write_payload(f, data))
+
+
+def atomic_write_files(items) -> None:
+    """Write several files (``{path: bytes}``), each atomically as :func:`atomic_write` does, with
+    one directory fsync per directory instead of one per file: every temporary file is written and
+    fsync'ed, then they are renamed in order, then each directory is fsync'ed once, so all of them
+    are durable when this returns (a view's files, before the view is recorded). If anything
+    fails, the temporary files not yet renamed are removed; renamed ones stay, each complete."""
+    staged: list[tuple[Path, Path]] = []
+    try:
+        for path, data in items.items():
+            path = Path(path)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}{TEMP_SUFFIX}"
+            staged.append((tmp, path))
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+            with os.fdopen(fd, "wb") as f:
+                write_payload(f, data)
+                f.flush()
+                os.fsync(f.fileno())
+        while staged:
+            tmp, path = staged[0]
+            os.replace(tmp, path)
+            staged.pop(0)
+    except BaseException:
+        for tmp, _ in staged:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
+        raise
+    for directory in dict.fromkeys(Path(p).parent for p in items):
+        fsync_dir(directory)
 
 
 def remove_stale_temp_files(root) -> list[Path]:

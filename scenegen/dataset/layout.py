@@ -4,6 +4,7 @@ All paths are relative POSIX paths inside the dataset folder (documented for rea
 this project in docs/dataset_format.md and docs/crossview.md)::
 
     manifest.json                           format, spec hash, seed, variant, versions, status, hashes
+    manifest.journal                        only while a run writes: views recorded since (journal.py)
     cameras.json                            per view: camera, cam_from_world, rig, optics, lights; the spec
     scene/meshes/<object>.ply               world-frame meshes
     scene/targets/<object>.json             calibration-target points (board and world frame)
@@ -31,6 +32,7 @@ from __future__ import annotations
 import re
 
 MANIFEST = "manifest.json"
+MANIFEST_JOURNAL = "manifest.journal"
 CAMERAS = "cameras.json"
 
 # View, object and mesh names become file names: keep them portable (no separators, no '..').
@@ -78,8 +80,8 @@ def check_rel_path(rel: str) -> str:
     parts = rel.split("/")
     if any(p in ("", ".", "..") or p.startswith(".") for p in parts):
         raise ValueError(f"dataset path {rel!r} has an empty, '.', '..' or hidden component")
-    if rel == MANIFEST:
-        raise ValueError(f"{MANIFEST} is written by the dataset writer only")
+    if rel in (MANIFEST, MANIFEST_JOURNAL):
+        raise ValueError(f"{rel} is written by the dataset writer only")
     return rel
 
 

@@ -26,8 +26,22 @@ MANIFEST_KEYS = IDENTITY_KEYS + ("views", "files", "manifest_sha256")
 def manifest_bytes(body: Mapping[str, Any]) -> bytes:
     """Canonical manifest bytes: ``body`` plus ``manifest_sha256``, the SHA-256 of the canonical
     JSON of ``body`` itself (so a changed byte anywhere in manifest.json is detected)."""
+    return manifest_bytes_and_sha256(body)[0]
+
+
+def manifest_bytes_and_sha256(body: Mapping[str, Any]) -> tuple[bytes, str]:
+    """:func:`manifest_bytes` and the ``manifest_sha256`` they hold.
+
+    The body is encoded once (JSON encoding is most of the cost of a large manifest): with sorted
+    keys and an indent of 2, the manifest is the body's text with the line
+    ``  "manifest_sha256": ...,`` inserted before the top-level ``"seed"`` line."""
     body = {k: v for k, v in body.items() if k != "manifest_sha256"}
-    return encode_json({**body, "manifest_sha256": sha256_bytes(encode_json(body))})
+    text = encode_json(body)
+    sha = sha256_bytes(text)
+    anchor = b'\n  "seed": '
+    if "seed" in body and text.count(anchor) == 1 and not any("manifest_sha256" < k < "seed" for k in body):
+        return text.replace(anchor, b'\n  "manifest_sha256": "' + sha.encode() + b'",' + anchor, 1), sha
+    return encode_json({**body, "manifest_sha256": sha}), sha  # any other body: encode again
 
 
 def manifest_integrity_error(data: bytes) -> tuple[dict | None, str | None]:

@@ -37,7 +37,8 @@ from scenegen.dataset.layout import (
     view_paths,
     vignetting_path,
 )
-from scenegen.dataset.manifest import STATUS_COMPLETE, load_manifest
+from scenegen.dataset.journal import load_current_manifest
+from scenegen.dataset.manifest import STATUS_COMPLETE
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
 from scenegen.geometry.camera import Camera
@@ -53,7 +54,7 @@ class Dataset:
 
     def __init__(self, out_dir):
         self.root = Path(out_dir)
-        self.manifest: dict = load_manifest(self.root)
+        self.manifest: dict = load_current_manifest(self.root)  # with an unfinished run's journal
         self._cameras: dict | None = None
         self._crossview: CrossviewTruth | None = None
 

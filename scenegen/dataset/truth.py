@@ -63,6 +63,9 @@ def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None =
         raise ValueError(f"truth is {hw} (H, W) but the image is {tuple(shape)}")
     out: dict[str, np.ndarray] = {"valid": valid}
     miss = ~valid
+    n_valid = int(np.count_nonzero(valid))
+    n_miss = valid.size - n_valid
+    # whole-array tests and counts: no copies through the masks (this runs on every frame)
     for key, (_, comps) in TRUTH_FLOAT_CHANNELS.items():
         a = np.asarray(truth[key])
         want = hw if comps is None else hw + (len(comps),)
@@ -71,22 +74,26 @@ def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None =
         if a.shape != want:
             raise ValueError(f"truth {key!r} must have shape {want}, got {a.shape}")
         a = a.astype(np.float32, copy=False)
+        n_comp = 1 if comps is None else len(comps)
         if key in ("depth_z", "range"):
-            if not np.all(a[miss] == np.inf):
+            if np.count_nonzero((a == np.inf) & miss) != n_miss:
                 raise ValueError(f"truth {key!r} must be +inf where valid is False")
-        elif not np.all(np.isnan(a[miss])):
-            raise ValueError(f"truth {key!r} must be NaN where valid is False")
-        if key != "uv" and not np.all(np.isfinite(a[valid])):
+        else:
+            planes = [a] if comps is None else [a[..., i] for i in range(n_comp)]  # contiguous when planar
+            if any(np.count_nonzero(np.isnan(p) & miss) != n_miss for p in planes):
+                raise ValueError(f"truth {key!r} must be NaN where valid is False")
+        # misses are +inf or NaN, never finite: all hits are finite iff the finite count is theirs
+        if key != "uv" and np.count_nonzero(np.isfinite(a)) != n_valid * n_comp:
             raise ValueError(f"truth {key!r} must be finite where valid is True")
         out[key] = a
     for key in TRUTH_ID_KEYS:
         a = np.asarray(truth[key])
         if not np.issubdtype(a.dtype, np.integer) or a.shape != hw:
             raise TypeError(f"truth {key!r} must be an integer (H, W) = {hw} array, got {a.dtype} {a.shape}")
-        if a.size and (a.min() < 0 or a.max() > _UINT32_MAX):
+        if a.dtype != np.uint32 and a.size and (a.min() < 0 or a.max() > _UINT32_MAX):
             raise ValueError(f"truth {key!r} values must lie in [0, 2^32 - 1]")
         a = a.astype(np.uint32, copy=False)
-        if np.any(a[miss] != 0):
+        if np.count_nonzero((a != 0) & miss):
             raise ValueError(f"truth {key!r} must be 0 where valid is False")
         out[key] = a
     return out

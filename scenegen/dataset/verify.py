@@ -1,13 +1,18 @@
 """``scenegen verify``: re-hash every file listed in a dataset's manifest and compare the folder
-with it (missing, corrupted and unexpected files, incomplete views, inconsistent listings)."""
+with it (missing, corrupted and unexpected files, incomplete views, inconsistent listings).
+
+A folder with a ``manifest.journal`` is a run that did not finish: that is reported, the journal
+is checked (a corrupt or torn line is reported) and its records count as listed."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
 from scenegen.dataset.codecs.json import read_json
+from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.files import sha256_file
-from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, view_paths
+from scenegen.dataset.journal import apply_record, pending_records, read_journal
+from scenegen.dataset.layout import CAMERAS, MANIFEST, MANIFEST_JOURNAL, check_rel_path, view_paths
 from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION, STATUS_COMPLETE, manifest_integrity_error
 
 
@@ -52,7 +57,8 @@ def verify(out_dir) -> VerifyReport:
     if not root.is_dir():
         return _report(problems=[f"{root} is not a directory"])
     if not mpath.is_file():
-        return _report(missing=[MANIFEST], problems=[f"no {MANIFEST}: not a scenegen dataset"])
+        extra = f" (but a {MANIFEST_JOURNAL}: the manifest was removed)" if (root / MANIFEST_JOURNAL).is_file() else ""
+        return _report(missing=[MANIFEST], problems=[f"no {MANIFEST}: not a scenegen dataset{extra}"])
     m, err = manifest_integrity_error(mpath.read_bytes())
     if err:
         return _report(corrupted=[MANIFEST],
@@ -61,6 +67,8 @@ def verify(out_dir) -> VerifyReport:
     if m["format"] != FORMAT or m["format_version"] != FORMAT_VERSION:
         problems.append(f"format {m['format']!r} version {m['format_version']!r} is not"
                         f" {FORMAT!r} version {FORMAT_VERSION}")
+    m, journal_problems = _with_journal(root, m)
+    problems += journal_problems
 
     missing, corrupted = [], []
     for rel, sha in m["files"].items():
@@ -74,7 +82,7 @@ def verify(out_dir) -> VerifyReport:
             missing.append(rel)
         elif sha256_file(p) != sha:
             corrupted.append(rel)
-    listed = set(m["files"]) | {MANIFEST}
+    listed = set(m["files"]) | {MANIFEST, MANIFEST_JOURNAL}
     unexpected = [p.relative_to(root).as_posix() for p in root.rglob("*")
                   if p.is_file() and p.relative_to(root).as_posix() not in listed]
 
@@ -95,3 +103,24 @@ def verify(out_dir) -> VerifyReport:
             if undeclared:
                 problems.append(f"views in {CAMERAS} but not in {MANIFEST}: {undeclared}")
     return _report(missing, corrupted, unexpected, incomplete, problems, checked=len(m["files"]))
+
+
+def _with_journal(root: Path, m: dict) -> tuple[dict, list[str]]:
+    """The manifest with an unfinished run's journal applied, and what to report about it."""
+    try:
+        journal = read_journal(root)
+        if journal is None:
+            return m, []
+        records = pending_records(m, journal, MANIFEST_JOURNAL)
+    except DatasetError as e:
+        return m, [f"{e}; checked against {MANIFEST} alone"]
+    problems = [(f"{MANIFEST_JOURNAL}: the run did not finish ({len(journal.records)} records not yet in"
+                 f" {MANIFEST}); run it again with --resume")]
+    if journal.torn_lines:
+        problems.append(f"{MANIFEST_JOURNAL}: {journal.torn_lines} incomplete last line(s) (a write cut by a"
+                        " crash; dropped by --resume)")
+    views = {v: {"status": e["status"], "files": list(e["files"])} for v, e in m["views"].items()}
+    files = dict(m["files"])
+    for r in records:
+        apply_record(views, files, r)
+    return {**m, "views": views, "files": files}, problems

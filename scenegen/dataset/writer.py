@@ -1,9 +1,10 @@
 """Writing a dataset: encode a view's files, write them atomically, hash them, keep the manifest.
 
-Crash safety: every file is written atomically (:mod:`scenegen.dataset.files`), and the manifest,
-rewritten atomically after each completed view, lists a view as ``complete`` only after all of
-its files are on disk, so a run killed at any point leaves a consistent dataset that
-``resume=True`` can finish. Same spec, seed, variant and software: byte-identical datasets,
+Crash safety: every file is written atomically (:mod:`scenegen.dataset.files`), and a view is
+recorded as ``complete`` (one fsync'd line of the manifest's journal, :mod:`.journal`, compacted
+into manifest.json when the run ends) only after all of its files are on disk, so a run killed
+at any point leaves a consistent dataset that ``resume=True`` can finish. Recording a view costs
+the same at any size of the run. Same spec, seed, variant and software: byte-identical datasets,
 whatever the order in which views were written.
 """
 from __future__ import annotations
@@ -23,8 +24,24 @@ from scenegen.dataset.codecs.json import decode_json, encode_json
 from scenegen.dataset.codecs.ply import encode_ply
 from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
-from scenegen.dataset.files import atomic_write_bytes, remove_stale_temp_files, sha256_bytes
-from scenegen.dataset.layout import CAMERAS, MANIFEST, check_rel_path, check_view_name, mesh_path, view_paths
+from scenegen.dataset.files import atomic_write_bytes, atomic_write_files, remove_stale_temp_files, sha256_bytes
+from scenegen.dataset.journal import (
+    JournalAppender,
+    file_record,
+    pending_records,
+    read_journal,
+    remove_journal,
+    view_record,
+)
+from scenegen.dataset.layout import (
+    CAMERAS,
+    MANIFEST,
+    MANIFEST_JOURNAL,
+    check_rel_path,
+    check_view_name,
+    mesh_path,
+    view_paths,
+)
 from scenegen.dataset.lock import LOCK_NAME, DatasetLock
 from scenegen.dataset.manifest import (
     FORMAT,
@@ -33,7 +50,7 @@ from scenegen.dataset.manifest import (
     STATUS_COMPLETE,
     STATUS_PENDING,
     load_manifest,
-    manifest_bytes,
+    manifest_bytes_and_sha256,
 )
 from scenegen.dataset.truth import LINEAR_CHANNELS, encode_truth
 
@@ -86,10 +103,8 @@ def write_view_files(out_dir, view: str, *, image, linear_rgb, truth,
     files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
     files.update(_checked_extra_files(view, extra_files, files))
     root = Path(out_dir)
-    hashes = {}
-    for rel, data in files.items():
-        atomic_write_bytes(root / rel, data)
-        hashes[rel] = sha256_bytes(data)
+    hashes = {rel: sha256_bytes(data) for rel, data in files.items()}
+    atomic_write_files({root / rel: data for rel, data in files.items()})
     return hashes
 
 
@@ -128,11 +143,16 @@ class DatasetWriter:
             if w.is_complete(view):
                 continue                                  # done by an earlier, interrupted run
             w.write_view(view, image=img, linear_rgb=lin, truth=truth)
+        w.close()                                         # the journal compacted into manifest.json
 
     ``resume=False`` needs ``out_dir`` absent or empty. ``resume=True`` loads an existing manifest,
     which must have been written with the same spec_sha256, seed, variant, format and versions
-    (else :class:`DatasetMismatchError`), removes temporary files left by a killed run, and keeps
-    the completed views; a directory without a manifest is started afresh if it is empty.
+    (else :class:`DatasetMismatchError`), and its journal (the views a killed run recorded since),
+    removes temporary files left by a killed run, and keeps the completed views; a directory
+    without a manifest is started afresh if it is empty.
+    Views and dataset-level files are recorded in the journal (``manifest.journal``, one
+    fsync'd line each); manifest.json is rewritten, and the journal removed, by
+    :meth:`write_cameras`, :meth:`close` and a resume.
     Re-writing a file that is already recorded with different content raises
     :class:`DatasetMismatchError` before anything is written: outputs must be deterministic.
     """
@@ -153,8 +173,19 @@ class DatasetWriter:
         self._views: dict[str, dict] = {}  # view -> {"status": ..., "files": [...]}
         self._files: dict[str, str] = {}  # relative path -> sha256
         self._view_order: list[str] = []
+        self._journal: JournalAppender | None = None  # open while records wait for compaction
+        self._manifest_sha = ""  # manifest_sha256 of manifest.json as last written
+        self.journal_bytes = 0  # bytes appended to journals by this writer (benchmarks)
 
         self._lock = DatasetLock.acquire(self.root)  # one writer per folder, before anything is touched
+        try:
+            self._open(identity, resume)
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def _open(self, identity: dict, resume: bool) -> None:
+        """Read (resume) or start the folder's manifest; the lock is held."""
         has_manifest = (self.root / MANIFEST).is_file()
         if resume and self.root.is_dir():
             remove_stale_temp_files(self.root)
@@ -169,10 +200,21 @@ class DatasetWriter:
             self._views = {v: {"status": e["status"], "files": list(e["files"])}
                            for v, e in m["views"].items()}
             self._files = dict(m["files"])
+            journal = read_journal(self.root)
+            records = [] if journal is None else pending_records(m, journal, str(self.root / MANIFEST_JOURNAL))
+            self._replay(records)
+            resumed_unchanged = not records  # manifest.json already holds this state, byte for byte
         elif self.root.exists() and any(p.name != LOCK_NAME for p in self.root.iterdir()):
-            hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
+            if (self.root / MANIFEST_JOURNAL).is_file() and not has_manifest:
+                hint = f"it has a {MANIFEST_JOURNAL} but no {MANIFEST}: the manifest was removed"
+            else:
+                hint = "pass resume=True (--resume) to finish it" if has_manifest else "it has no manifest"
             raise DatasetError(f"{self.root} is not empty ({hint}); use a new or empty directory")
-        self._write_manifest()
+        if resume and has_manifest and resumed_unchanged:
+            self._manifest_sha = m["manifest_sha256"]  # no rewrite of a large manifest to the same bytes
+            remove_journal(self.root)  # a stale one
+        else:
+            self._write_manifest()
 
     # --- state
     def is_complete(self, view: str) -> bool:
@@ -224,8 +266,8 @@ class DatasetWriter:
                 " dataset belongs to another run")
         atomic_write_bytes(self.root / rel_path, data)
         self._files[rel_path] = sha
-        if _flush:
-            self._write_manifest()
+        if _flush and old != sha:
+            self._log([file_record(rel_path, sha)])
         return sha
 
     def write_view(self, view: str, *, image, linear_rgb, truth,
@@ -238,21 +280,22 @@ class DatasetWriter:
         files.update(_checked_extra_files(view, extra_files, files))
         hashes = {rel: sha256_bytes(d) for rel, d in files.items()}
         self._check_rerecord(view, hashes)  # before writing anything
-        for rel, data in files.items():
-            atomic_write_bytes(self.root / rel, data)
+        atomic_write_files({self.root / rel: data for rel, data in files.items()})  # durable, then recorded
         self.record_view(view, hashes)
 
     def record_view(self, view: str, file_hashes: Mapping[str, str]) -> None:
         """Mark ``view`` complete with the files (``{relative path: sha256}``) already written,
-        e.g. by :func:`write_view_files` in a worker; rewrites the manifest atomically."""
+        e.g. by :func:`write_view_files` in a worker: one fsync'd journal line."""
+        if self._is_recorded(view, file_hashes):
+            return  # the same files again (a rewrite of a complete view): nothing new to record
         self._record(view, file_hashes)
-        self._write_manifest()
+        self._log([view_record(view, file_hashes)])
 
     def record_views(self, views: Mapping[str, Mapping[str, str]]) -> None:
         """:meth:`record_view` for several views (``{view: {relative path: sha256}}``, in order)
-        with one manifest rewrite: the manifest's size grows with the run, so a client recording
-        many workers' views batches what is ready. Nothing is recorded if any view is invalid."""
-        views = dict(views)
+        with one fsync: a client recording many workers' views batches what is ready. Nothing is
+        recorded if any view is invalid."""
+        views = {v: h for v, h in views.items() if not self._is_recorded(v, h)}
         snapshot = ({v: {"status": e["status"], "files": list(e["files"])} for v, e in self._views.items()},
                     dict(self._files))
         try:
@@ -261,7 +304,13 @@ class DatasetWriter:
         except Exception:
             self._views, self._files = snapshot
             raise
-        self._write_manifest()
+        if views:
+            self._log([view_record(v, h) for v, h in views.items()])
+
+    def _is_recorded(self, view: str, file_hashes: Mapping[str, str]) -> bool:
+        e = self._views.get(view)
+        return (e is not None and e["status"] == STATUS_COMPLETE and sorted(e["files"]) == sorted(file_hashes)
+                and all(self._files.get(r) == h for r, h in file_hashes.items()))
 
     def _record(self, view: str, file_hashes: Mapping[str, str]) -> None:
         check_view_name(view)
@@ -279,15 +328,28 @@ class DatasetWriter:
         self._views[view] = {"status": STATUS_COMPLETE, "files": sorted(file_hashes)}
 
     def close(self) -> None:
-        """Write the manifest a last time (every method already leaves it up to date)."""
-        self._write_manifest()
+        """Compact the journal into manifest.json (atomically) and remove it: a finished dataset."""
+        try:
+            self._write_manifest()
+        finally:
+            self._lock.release()
+
+    def abort(self) -> None:
+        """Release the folder without compacting (after a failure: the journal already holds
+        every recorded view, so ``--resume`` continues from here)."""
+        if self._journal is not None:
+            self._journal.close()
+            self._journal = None
         self._lock.release()
 
     def __enter__(self) -> "DatasetWriter":
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
     # --- internals
     def _check_rerecord(self, view: str, hashes: Mapping[str, str]) -> None:
@@ -305,11 +367,41 @@ class DatasetWriter:
             raise ValueError(f"view {view!r}: files {taken} already belong to another view or the dataset")
 
     def _manifest_bytes(self) -> bytes:
+        return self._manifest_bytes_and_sha256()[0]
+
+    def _manifest_bytes_and_sha256(self) -> tuple[bytes, str]:
         body = dict(self._identity)
-        body["views"] = {v: {"status": e["status"], "files": sorted(e["files"])}
-                         for v, e in self._views.items()}
+        body["views"] = {v: {"status": e["status"], "files": sorted(e["files"])} for v, e in self._views.items()}
         body["files"] = dict(self._files)
-        return manifest_bytes(body)
+        return manifest_bytes_and_sha256(body)
 
     def _write_manifest(self) -> None:
-        atomic_write_bytes(self.root / MANIFEST, self._manifest_bytes())
+        """Rewrite manifest.json from the writer's state, then drop the journal it now contains."""
+        data, self._manifest_sha = self._manifest_bytes_and_sha256()
+        atomic_write_bytes(self.root / MANIFEST, data)
+        if self._journal is not None:
+            self._journal.close()
+            self._journal = None
+        remove_journal(self.root)  # also a stale one a killed run left
+
+    def _log(self, records) -> None:
+        """Append records to the journal (started on first use after a manifest rewrite)."""
+        if self._journal is None:
+            self._journal = JournalAppender(self.root, self._manifest_sha)
+        before = self._journal.bytes_written
+        self._journal.append(records)
+        self.journal_bytes += self._journal.bytes_written - before
+
+    def _replay(self, records) -> None:
+        """Apply a killed run's journal records, checked as when they were first recorded."""
+        for rec in records:
+            try:
+                if rec["op"] == "view":
+                    self._record(rec["view"], rec["files"])
+                else:
+                    check_rel_path(rec["path"])
+                    if not re.fullmatch(r"[0-9a-f]{64}", rec["sha256"]):
+                        raise ValueError(f"{rec['path']}: sha256 must be 64 lower-case hex digits")
+                    self._files[rec["path"]] = rec["sha256"]
+            except (ValueError, TypeError) as e:
+                raise DatasetError(f"{self.root / MANIFEST_JOURNAL}: record {rec.get('n')}: {e}") from None

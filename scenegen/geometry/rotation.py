@@ -15,7 +15,6 @@ a 1e-8 rad rotation reads as 0 or ~1.5e-8 with arccos in float64) and near pi.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 #: Orthonormality tolerance of :func:`is_rotation`: admits matrices written with ~7 significant
 #: digits (JSON, YAML or text files written by hand or in float32).
@@ -41,9 +40,16 @@ def as_rotation(R) -> np.ndarray:
 
 
 # --- parametrisations --------------------------------------------------------------------------
+def _rotation_class():
+    # scipy on use: ~0.3 s to import, and every module of the project imports this one
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
+
+
 def quat_wxyz_from_matrix(R) -> np.ndarray:
     """Unit quaternion (w, x, y, z) with w >= 0 of a (3, 3) rotation matrix."""
-    q = Rotation.from_matrix(np.asarray(R, float)).as_quat(scalar_first=True)
+    q = _rotation_class().from_matrix(np.asarray(R, float)).as_quat(scalar_first=True)
     return q if q[0] >= 0 else -q
 
 
@@ -57,22 +63,22 @@ def matrix_from_quat_wxyz(q_wxyz) -> np.ndarray:
         return np.zeros((0, 3, 3))
     if not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q.reshape(-1, 4), axis=1) == 0):
         raise ValueError(f"quaternion must be 4 finite numbers, not all zero; got {q_wxyz!r}")
-    return Rotation.from_quat(q, scalar_first=True).as_matrix()
+    return _rotation_class().from_quat(q, scalar_first=True).as_matrix()
 
 
 def matrix_from_rotvec(rotvec_rad) -> np.ndarray:
     """(3, 3) rotation of an axis-angle vector (radians), or (N, 3, 3) of (N, 3)."""
-    return Rotation.from_rotvec(np.asarray(rotvec_rad, float)).as_matrix()
+    return _rotation_class().from_rotvec(np.asarray(rotvec_rad, float)).as_matrix()
 
 
 def rotvec_from_matrix(R) -> np.ndarray:
     """Axis-angle vector (radians) of a (3, 3) rotation."""
-    return Rotation.from_matrix(np.asarray(R, float)).as_rotvec()
+    return _rotation_class().from_matrix(np.asarray(R, float)).as_rotvec()
 
 
 def rotation_from_euler_deg(angles_deg, order: str = "xyz") -> np.ndarray:
     """Rotation matrix from Euler angles in degrees (extrinsic axes, scipy lower-case ``order``)."""
-    return Rotation.from_euler(order, np.asarray(angles_deg, float), degrees=True).as_matrix()
+    return _rotation_class().from_euler(order, np.asarray(angles_deg, float), degrees=True).as_matrix()
 
 
 # --- angles ------------------------------------------------------------------------------------

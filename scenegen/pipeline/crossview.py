@@ -77,7 +77,7 @@ class _Context:
     def points(self, name) -> np.ndarray:
         """(H, W, 3) float64 world truth points of a view (NaN = no surface)."""
         if name not in self._points:
-            t = view_truth(self.built, self.views[name])  # the same call as the view's stored truth
+            t = view_truth(self.built, self.views[name], as_stored=True)  # the call (and kernel) of the stored truth
             self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
         return self._points[name]
 

@@ -6,7 +6,7 @@ it sees ``(spec, variant, spp, Mitsuba variant)`` and keeps it (:data:`_SCENES`,
 :data:`SCENES_KEPT` scenes), renders the frame's views, writes their files with
 :func:`scenegen.dataset.writer.write_view_files` and returns the hashes. The client records each
 view with :meth:`~scenegen.dataset.writer.DatasetWriter.record_views` in the run's order (every frame
-already done at once: one manifest rewrite, whose cost grows with the run), so the manifest is
+already done at once: one fsync'd batch of journal lines), so the manifest is
 byte-identical to a serial run's, and a run killed at any point resumes like a serial one. A
 worker killed mid-write leaves a temporary file; the client removes those once every task is done.
 
@@ -123,7 +123,7 @@ def render_views_dask(client, source, writer, pending, *, spp: int, seed: int, v
     try:
         while k < len(futures):  # in the run's order: the manifest grows as in a serial run
             batch = dict(futures[k].result())  # wait for the next frame, then take every
-            k += 1                              # following one already done: one manifest rewrite
+            k += 1                              # following one already done: one journal fsync
             while k < len(futures) and futures[k].done():
                 batch.update(futures[k].result())
                 k += 1

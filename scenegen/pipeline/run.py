@@ -8,6 +8,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from scenegen.dataset.background import BackgroundWriter
 from scenegen.dataset.cameras import ViewCamera
 from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.layout import target_path
@@ -114,24 +115,24 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
         writer.write_file(target_path(name), encode_json(target_document(board, world_from_board)))
 
     todo = [(i, v) for i, v in enumerate(views) if wanted is None or v.frame_index in wanted]
-    skipped = sum(writer.is_complete(v.name) for _, v in todo)
+    pending = [(index, v) for index, v in todo if not writer.is_complete(v.name)]
+    skipped = len(todo) - len(pending)
     rendered = 0
     with FrameProgress(progress, len(todo)) as bar:
+        for _ in range(skipped):
+            bar.advance()
         if dask_client is not None:  # workers render and write; recorded here in the run's order
-            for _ in range(skipped):
-                bar.advance()
-            pending = [(index, v) for index, v in todo if not writer.is_complete(v.name)]
             rendered = render_views_dask(
                 dask_client, source or SpecSource.from_path(spec_path), writer, pending, spp=spp,
                 seed=seed, variant=used.variant, on_done=bar.advance)
-        for index, v in todo if dask_client is None else ():
-            if writer.is_complete(v.name):
-                bar.advance()
-                continue
-            image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
-            writer.write_view(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra)
-            rendered += 1
-            bar.advance()
+        else:  # a view is encoded and written on a thread while the next one renders
+            with BackgroundWriter(writer) as background:
+                for index, v in pending:
+                    image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
+                    background.submit(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra)
+                    del image, linear, truth, extra  # the writer holds the only references
+                    rendered += 1
+                    bar.advance()
     run_crossview(spec, views, built, writer, spp=spp, seed=seed)  # cross-view truth (docs/crossview.md)
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)

@@ -27,14 +27,11 @@ def rolling_shutter_rows(built, view):
     return row_poses(view.cam_from_world, view.motion, shutter, built.cameras[view.camera].height)
 
 
-def view_truth(built, view) -> dict[str, np.ndarray]:
-    """The truth pass of a view as the dataset stores it: per-row poses for a rolling shutter;
-    range and depth_z in float64 (rounded to float32 when written)."""
-    return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view))
-
-
-def _truth_for_storage(truth: dict) -> dict:
-    return {k: v.astype(np.float32) if v.dtype == np.float64 else v for k, v in truth.items()}
+def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
+    """The truth pass of a view: per-row poses for a rolling shutter; range and depth_z in
+    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``."""
+    return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view),
+                       as_stored=as_stored)
 
 
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
@@ -42,7 +39,7 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     :func:`scenegen.dataset.writer.encode_view`; ``index`` is the view's position in the run."""
     linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
                           light_scales=v.light_scales)
-    truth = view_truth(built, v)
+    truth = view_truth(built, v, as_stored=True)
     params = spec.cameras[v.camera].imaging
     if params is None:  # clean path: sRGB encoding of the linear render
         image, extra = srgb_image(linear, spec.render.bit_depth), None
@@ -50,7 +47,7 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
         # mosaic with imaging.raw
         image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name,
                                      camera_name=v.camera)
-    return image, linear, _truth_for_storage(truth), extra
+    return image, linear, truth, extra
 
 
 def view_optics(built, view) -> dict | None:

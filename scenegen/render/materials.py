@@ -25,7 +25,8 @@ def bitmap(img: np.ndarray, wrap_mode: str = "repeat") -> dict:
 
     Procedural textures tile seamlessly, so they repeat (no visible UV seam on spheres and tori);
     board pictures clamp, so no opposite edge bleeds into the board's border."""
-    return {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)),
+    # a writable copy: mi.Bitmap takes no read-only array (cached textures are read-only)
+    return {"type": "bitmap", "bitmap": mi.Bitmap(np.array(img, dtype=np.float32, order="C")),
             "raw": True, "filter_type": "bilinear", "wrap_mode": wrap_mode}
 
 

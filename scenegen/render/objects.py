@@ -15,6 +15,7 @@ import trimesh
 from scenegen.assets import meshes, shapes
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
+from scenegen.render.arrays import to_jit
 from scenegen.render.materials import board_material, material_dict
 
 
@@ -38,8 +39,9 @@ def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool):
     mm = mi.Mesh(name, len(mesh.vertices), len(mesh.faces), props=props,
                  has_vertex_normals=smooth, has_vertex_texcoords=uv is not None)
     params = mi.traverse(mm)
-    # the buffers' own types: Dr.Jit arrays in vectorised variants, dynamic arrays in scalar ones
-    put = lambda key, a, dtype: params.__setitem__(key, type(params[key])(np.asarray(a, dtype).ravel()))
+    # the buffers' own types: Dr.Jit arrays in vectorised variants, dynamic arrays in scalar ones;
+    # aligned copies, so the kernels do not depend on numpy's addresses (scenegen.render.arrays)
+    put = lambda key, a, dtype: params.__setitem__(key, to_jit(type(params[key]), a, dtype))
     put("vertex_positions", mesh.vertices, np.float32)
     put("faces", mesh.faces, np.uint32)
     if smooth:
@@ -102,7 +104,7 @@ def place_moving_objects(built, tau_s: float) -> None:
         if mv.sphere_to_world is not None:
             params[f"{mv.key}.to_world"] = mi.ScalarTransform4f(move.matrix @ mv.sphere_to_world)
             continue
-        put = lambda k, a: params.__setitem__(k, type(params[k])(np.asarray(a, np.float32).ravel()))
+        put = lambda k, a: params.__setitem__(k, to_jit(type(params[k]), a, np.float32))
         put(f"{mv.key}.vertex_positions", move.apply(mv.vertices))
         if mv.normals is not None:
             put(f"{mv.key}.vertex_normals", move.rotate(mv.normals))

@@ -3,7 +3,9 @@ surface point behind any sub-pixel position. The scene must be loaded (the curre
 
 All rays of one call are intersected in ONE ``dr.eval`` (converting outputs one by one re-runs
 the kernel, see shared notes). Ray origins and directions go to Mitsuba in float32; distances
-come back as float32 and are widened to float64.
+come back as float32 and are widened to float64. The ray origin is an opaque Dr.Jit scalar: as a
+literal it would be compiled into the kernel, and every new camera centre (every direction of
+every view pair) would compile the kernel again (0.3-0.7 s each).
 """
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ import mitsuba as mi
 import numpy as np
 
 from scenegen.dataset.crossview import OCCLUSION_REL_TOL
+from scenegen.render.arrays import to_jit
 
 
 def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarray, np.ndarray]:
@@ -33,9 +36,13 @@ def first_hit_distance(scene, origin_world, directions_world) -> tuple[np.ndarra
     return t, pts
 
 
+def _origin(o) -> "mi.Point3f":
+    """A ray origin as opaque float32 scalars (rounded from float64 as a literal would be)."""
+    return mi.Point3f(*[dr.opaque(mi.Float, float(c)) for c in o])
+
+
 def _first_hits_vectorised(scene, o, d) -> np.ndarray:
-    ray = mi.Ray3f(mi.Point3f(*[float(c) for c in o]),
-                   mi.Vector3f(d[:, 0].astype(np.float32), d[:, 1].astype(np.float32), d[:, 2].astype(np.float32)))
+    ray = mi.Ray3f(_origin(o), mi.Vector3f(*[to_jit(mi.Float, d[:, i], np.float32) for i in range(3)]))
     si = scene.ray_intersect_preliminary(ray, coherent=False)
     hit = si.is_valid()
     t = dr.select(hit, si.t, dr.inf)
@@ -48,15 +55,38 @@ def visible_from(scene, center_world, points_world, rel_tol: float = OCCLUSION_R
     up to ``rel_tol`` of the distance (see :data:`OCCLUSION_REL_TOL`). NaN points -> False."""
     P = np.asarray(points_world, np.float64)
     C = np.asarray(center_world, np.float64)
-    ok = np.all(np.isfinite(P), axis=1)
+    ok = np.isfinite(P[:, 0]) & np.isfinite(P[:, 1]) & np.isfinite(P[:, 2])
     out = np.zeros(len(P), bool)
     if not ok.any():
         return out
-    v = P[ok] - C
-    dist = np.linalg.norm(v, axis=1)
-    t, _ = first_hit_distance(scene, C, v / dist[:, None])
-    out[np.flatnonzero(ok)] = t >= dist * (1.0 - rel_tol)
+    if ok.all() and not mi.variant().startswith("scalar"):  # the usual case: no copy
+        return _visible_vectorised(scene, C, P, rel_tol)
+    if mi.variant().startswith("scalar"):
+        v = P[ok] - C
+        dist = np.linalg.norm(v, axis=1)
+        t, _ = first_hit_distance(scene, C, v / dist[:, None])
+        out[np.flatnonzero(ok)] = t >= dist * (1.0 - rel_tol)
+        return out
+    out[np.flatnonzero(ok)] = _visible_vectorised(scene, C, P[ok], rel_tol)
     return out
+
+
+def _visible_vectorised(scene, C, P, rel_tol: float) -> np.ndarray:
+    """The visibility test in one kernel: the same float64 operations, in the same order, as
+    ``v = P - C; dist = np.linalg.norm(v, axis=1); d = v / dist`` in numpy (so the same bits),
+    the ray cast, and the comparison; only the (M,) booleans come back."""
+    c64 = [dr.opaque(mi.Float64, float(c)) for c in C]
+    v = [to_jit(mi.Float64, P[:, i], np.float64) - c64[i] for i in range(3)]
+    dist = dr.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    d = mi.Vector3f(*[mi.Float(vi / dist) for vi in v])
+    # coherent=False, as before: Embree's coherent mode is ~1.5x faster on these pixel-ordered rays
+    # but decides a grazing ray differently (one pixel of scenes/triangulation_baselines.yaml
+    # turned from occluded to visible), and the bytes must not change
+    si = scene.ray_intersect_preliminary(mi.Ray3f(_origin(C), d), coherent=False)
+    t = dr.select(si.is_valid(), mi.Float64(si.t), dr.inf)
+    visible = t >= dist * (1.0 - rel_tol)
+    dr.eval(visible)
+    return visible.numpy().copy()
 
 
 def surface_points(scene, camera, cam_from_world, uv) -> np.ndarray:

@@ -17,7 +17,7 @@ from scenegen.render import raycast, sensor as sensor_mod
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entry
-from scenegen.render.truth import shape_id_table, truth_pass
+from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 
 
@@ -57,9 +57,9 @@ class LoadedScene:
         return render_ideal(self, sensor_camera_name, camera, cam_from_world, spp=spp, seed=seed,
                             light_scales=light_scales)
 
-    def truth(self, camera, cam_from_world: Rigid3, row_poses=None) -> dict[str, np.ndarray]:
+    def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False) -> dict[str, np.ndarray]:
         """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
-        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses)
+        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored)
 
     def visible_from(self, center_world, points_world) -> np.ndarray:
         """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""
@@ -105,4 +105,6 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     built.light_scales = (1.0,) * len(spec.lights)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
+    for cam in built.cameras.values():
+        prepare_camera(cam)  # the truth pass's ray table, made here rather than in frame 0
     return built

@@ -1,5 +1,6 @@
 """scenegen.dataset: layout, determinism, resume after a crash, reader round trip, verify."""
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -65,6 +66,7 @@ def write_dataset(out, views=VIEWS, writer=None):
     for v in views:
         if not w.is_complete(v):
             w.write_view(v, **make_view(VIEWS.index(v)))
+    w.close()  # compacts the journal into manifest.json
     return w
 
 
@@ -163,7 +165,7 @@ class TestDeterminism:
         w.write_mesh("box", trimesh.creation.box(extents=(1, 2, 3)))
         for i, v in enumerate(VIEWS):
             w.record_view(v, ds.write_view_files(out, v, **make_view(i)))
-        w.close()  # releases the folder's lock (scenegen/dataset/lock.py)
+        w.close()  # compacts the journal and releases the folder's lock
         assert all_bytes(out) == all_bytes(complete)
 
 
@@ -171,20 +173,20 @@ class TestResume:
     def test_resume_after_kill_equals_uninterrupted(self, tmp_path, complete, monkeypatch):
         out = tmp_path / "b"
         write_dataset(out, views=VIEWS[:2])
-        # a "kill" in the middle of the third view: two of its files written, then death
-        real, calls = files.atomic_write_bytes, []
+        # a "kill" in the middle of the third view: two of its files in place, then death
+        real, calls = os.replace, []
 
-        def dying(path, data):
-            if Path(path).name != "manifest.json":
-                calls.append(path)
+        def dying(src, dst):
+            if Path(dst).name != "manifest.json":
+                calls.append(dst)
             if len(calls) == 3:
                 raise KeyboardInterrupt("SIGKILL stand-in")
-            real(path, data)
+            real(src, dst)
 
-        monkeypatch.setattr(writer_module, "atomic_write_bytes", dying)
+        monkeypatch.setattr(os, "replace", dying)
         with pytest.raises(KeyboardInterrupt):
             new_writer(out, resume=True).write_view(VIEWS[2], **make_view(2))
-        monkeypatch.setattr(writer_module, "atomic_write_bytes", real)
+        monkeypatch.setattr(os, "replace", real)
         (out / "truth" / f".x.exr.123{files.TEMP_SUFFIX}").write_bytes(b"half")  # a killed temp file
 
         m = sio.read_json(out / "manifest.json")
@@ -346,17 +348,12 @@ sys.path.insert(0, sys.argv[2])
 from scenegen.dataset import files
 import test_dataset as t
 
-real = files.atomic_write
+real = files.write_payload
 
-def slow(path, write_fn):
-    def halves(f):  # be killable between the two halves of every file
-        class Half:
-            def write(self, b):
-                f.write(b[: len(b) // 2]); f.flush(); time.sleep(0.01); f.write(b[len(b) // 2:])
-        write_fn(Half())
-    real(path, halves)
+def slow(f, data):  # be killable between the two halves of every file
+    f.write(data[: len(data) // 2]); f.flush(); time.sleep(0.01); real(f, data[len(data) // 2:])
 
-files.atomic_write = slow
+files.write_payload = slow
 t.write_dataset(t.Path(sys.argv[1]))
 print("finished")
 """
@@ -372,8 +369,8 @@ def test_sigkill_and_resume_equals_uninterrupted(tmp_path, complete):
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline and proc.poll() is None:
         try:
-            views = json.loads((out / "manifest.json").read_bytes())["views"]
-        except (FileNotFoundError, ValueError, KeyError):
+            views = ds.load_current_manifest(out)["views"]  # manifest.json + the run's journal
+        except (ds.DatasetError, FileNotFoundError, ValueError, KeyError):
             views = {}
         if sum(e["status"] == "complete" for e in views.values()) >= 2:
             break

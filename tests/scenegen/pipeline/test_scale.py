@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from scenegen.cli import main
-from scenegen.dataset import Dataset, verify
+from scenegen.dataset import Dataset, DatasetError, load_current_manifest, verify
 from scenegen.dataset.files import sha256_file
 from scenegen.errors import SpecError
 from scenegen.spec import load_spec, parse_spec, spec_sha256, spec_to_dict
@@ -211,8 +211,8 @@ def test_dask_workers_match_serial_run_and_load_each_scene_once(tmp_path):
 # --- kill and resume ----------------------------------------------------------------------------
 def _complete_views(out: Path) -> int:
     try:
-        m = json.loads((out / "manifest.json").read_text())
-    except (OSError, ValueError):
+        m = load_current_manifest(out)  # manifest.json plus the running writer's journal
+    except (OSError, ValueError, DatasetError):
         return 0
     return sum(e["status"] == "complete" for e in m["views"].values())
 
@@ -324,4 +324,8 @@ def test_record_views_batches_into_the_same_manifest_and_is_all_or_nothing(tmp_p
         batched.record_views(bad)
     assert batched.completed_views == ("v0",)  # v1 was not recorded either
     batched.record_views({v: hashes[v] for v in ("v1", "v2", "v3")})
+    assert ds.load_current_manifest(tmp_path / "batched") == ds.load_current_manifest(tmp_path / "one")
+    one.close()
+    batched.close()
     assert (tmp_path / "batched" / "manifest.json").read_bytes() == (tmp_path / "one" / "manifest.json").read_bytes()
+    assert not (tmp_path / "one" / "manifest.journal").exists()
