@@ -29,6 +29,7 @@ from xml.sax.saxutils import quoteattr
 from recon_eval.errors import InputError
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Node
+from scenegen.located_yaml.source import read_source
 
 OPS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge, "==": operator.eq,
        "!=": operator.ne}
@@ -62,10 +63,7 @@ def load_gates(path) -> list[Gate]:
     """Parse and validate a gate file; errors name file:line: field."""
     p = Path(path)
     try:
-        text = p.read_text()
-    except OSError as exc:
-        raise InputError(f"{p}: cannot read ({exc.strerror})") from None
-    try:
+        text = read_source(p, "gate file")  # size limit, UTF-8, one-line errors
         return _gates(Document(text, str(p), p.parent).root)
     except SpecError as exc:  # the located-YAML layer's error, as recon_eval's bad input
         raise InputError(str(exc)) from None
@@ -109,6 +107,8 @@ def load_results(paths) -> list[tuple[str, dict]]:
             raise InputError(f"{p}: cannot read ({exc.strerror})") from None
         except json.JSONDecodeError as exc:
             raise InputError(f"{p}:{exc.lineno}: invalid JSON: {exc.msg}") from None
+        except RecursionError:
+            raise InputError(f"{p}: invalid JSON: nested too deeply") from None
         if isinstance(doc, dict) and doc.get("command") == "run":
             out.append((str(p), doc))
         elif isinstance(doc, dict) and doc.get("command") == "leaderboard":

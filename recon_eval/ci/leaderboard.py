@@ -13,6 +13,7 @@ from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report.document import write_json_atomic
 from recon_eval.report.leaderboard_page import html_page, markdown
 from recon_eval.runners import method, run_method
+from scenegen.dataset.layout import check_name
 
 
 def run_leaderboard(datasets, methods, out_dir, *, log=print) -> dict:
@@ -22,6 +23,10 @@ def run_leaderboard(datasets, methods, out_dir, *, log=print) -> dict:
     runs, skipped = [], []
     for d in datasets:
         scene = read_dataset(d).scene_name
+        try:
+            check_name("scene", scene)  # it becomes a folder under out_dir: no '/', no '..'
+        except ValueError as exc:
+            raise InputError(f"{d}: the dataset's scene name cannot be a folder name: {exc}") from None
         for m in methods:
             try:
                 doc = run_method(m, d, out / scene / m)

@@ -22,7 +22,7 @@ def read_matrix3(path, key: str | None = None) -> np.ndarray:
     if p.suffix.lower() == ".json":
         try:
             obj = json.loads(text)
-        except json.JSONDecodeError as exc:
+        except (json.JSONDecodeError, RecursionError) as exc:  # RecursionError: nested too deeply
             raise InputError(f"{p}: invalid JSON ({exc})") from None
         if isinstance(obj, dict):
             if key is None or key not in obj:

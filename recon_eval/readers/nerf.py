@@ -87,7 +87,7 @@ def read_nerf_transforms(path) -> NerfTransforms:
         raise InputError(f"{p}: no such file (expected a NeRF transforms.json)")
     try:
         doc = json.loads(read_text(p, "a NeRF transforms.json"))
-    except json.JSONDecodeError as exc:
+    except (json.JSONDecodeError, RecursionError) as exc:  # RecursionError: nested too deeply
         raise InputError(f"{p}: invalid JSON ({exc})") from None
     if not isinstance(doc, dict) or not isinstance(doc.get("frames"), list):
         raise InputError(f"{p}: frames: expected a list of frames with file_path and transform_matrix")

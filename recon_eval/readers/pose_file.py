@@ -48,7 +48,7 @@ def read_pose(path, convention: str = "cam_from_world") -> tuple[np.ndarray, np.
     elif p.suffix.lower() == ".json":
         try:
             obj = json.loads(read_text(p, "a camera pose as JSON"))
-        except json.JSONDecodeError as exc:
+        except (json.JSONDecodeError, RecursionError) as exc:  # RecursionError: nested too deeply
             raise InputError(f"{p}: invalid JSON ({exc})") from None
         if isinstance(obj, dict):
             for key in CONVENTIONS:

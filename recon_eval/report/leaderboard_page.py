@@ -22,9 +22,16 @@ def rows(doc: dict) -> list[tuple[str, str, str]]:
     return out
 
 
+def markdown_text(text: str) -> str:
+    """``text`` as plain Markdown table-cell text: HTML escaped (no raw ``<script>`` from a name
+    or an error message), Markdown's own marks and the cell separator backslash-escaped, one line."""
+    text = html.escape(" ".join(str(text).split()), quote=False)
+    return "".join("\\" + c if c in "\\`*_[]|#" else c for c in text)
+
+
 def markdown(doc: dict) -> str:
     lines = ["| scene | method | metrics |", "|---|---|---|"]
-    lines += [f"| `{s}` | `{m}` | {ms} |" for s, m, ms in rows(doc)]
+    lines += [f"| {markdown_text(s)} | {markdown_text(m)} | {markdown_text(ms)} |" for s, m, ms in rows(doc)]
     return "\n".join(lines) + "\n"
 
 
