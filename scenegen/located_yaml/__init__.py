@@ -22,6 +22,9 @@ from scenegen.located_yaml.text import non_finite_text, number_text, source_text
 
 _NUMBER_RE = re.compile(r"^[-+]?(\d[\d_]*\.?[\d_]*|\.\d[\d_]*)([eE][-+]?\d+)?$")
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+#: Longest name (scene, object, camera, ...): names become file names; equal to
+#: scenegen.dataset.layout.MAX_NAME_LEN (tests/hostile/test_hostile_limits.py checks).
+MAX_NAME_LEN = 128
 
 
 def suggest(word: str, choices: Iterable[str]) -> str:
@@ -134,6 +137,9 @@ class Node:
 
     def as_name(self, what: str = "a name") -> str:
         v = self.as_str(what)
+        if len(v) > MAX_NAME_LEN:
+            raise self.error(f"expected {what} of at most {MAX_NAME_LEN} characters (names become file "
+                             f"names), got {len(v)} characters {v[:20]!r}...")
         if not NAME_RE.match(v):
             raise self.error(f"expected {what} made of letters, digits, '_' and '-' "
                              f"(starting with a letter or digit), got {v!r}")

@@ -11,12 +11,14 @@ from pathlib import Path
 
 from scenegen.errors import SpecError
 
-#: Largest YAML file read, in bytes (16 MiB). Why: the composer keeps every node with its marks
-#: (about 0.5 KB per value), and a spec's readers walk them; at 16 MiB a file of small values is
-#: ~1.5 million nodes, about 1 GB and ~20 s to compose (docs/reliability.md has the measured
-#: rate). The largest bundled spec is under 20 KB; a generated scene with 10,000 objects is
-#: about 2 MB. A larger scene belongs in meshes (files the spec names), not in the YAML.
-MAX_SOURCE_BYTES = 16 * 1024 * 1024
+#: Largest YAML file read, in bytes (2 MiB). Why: YAML is composed in pure Python (PyYAML's
+#: SafeLoader: the C loader keeps no source text and cannot refuse deep nesting before it
+#: recurses) at about 0.1 MiB per second on a loaded machine, 2-5 times faster on an idle one
+#: (docs/reliability.md has the measurements): a 2 MiB spec (about 40,000 explicit camera poses)
+#: validates in seconds, a 50 MB one would take minutes. The largest bundled spec is under 20 KB;
+#: many views belong in generated placements (orbit, random, line, circle), large geometry in
+#: the mesh files the spec names.
+MAX_SOURCE_BYTES = 2 * 1024 * 1024
 
 _BOMS = ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
          (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16"))
