@@ -19,6 +19,7 @@ from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entry
 from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
+from scenegen.spec.assets_check import located
 
 
 @dataclass
@@ -83,7 +84,8 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     object_ids, instance_ids = {}, {}
     for obj in spec.objects:
         key = object_key(obj)
-        d[key] = object_entry(obj, built)
+        with located(obj, f"object {obj.name!r}"):  # asset errors name the spec's file:line
+            d[key] = object_entry(obj, built)
         if obj.motion is not None and not obj.motion.is_static:
             built.moving.append(moving_entry(key, obj, d[key], built.meshes_world[obj.name]))
         object_ids[key] = obj.object_id

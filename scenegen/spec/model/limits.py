@@ -4,6 +4,11 @@ allocated, so a hostile or mistyped size fails in milliseconds with its file:lin
 out-of-memory error (or hours of work) in the renderer."""
 from __future__ import annotations
 
+from scenegen.assets.checks import MAX_MESH_FACES, MAX_MESH_FILE_BYTES, MAX_TEXTURE_PIXELS
+
+__all__ = ["MAX_IMAGE_SIDE_PX", "MAX_IMAGE_PIXELS", "MAX_SPP", "MAX_VIEWS", "MAX_BOARD_SIDE", "MAX_MESH_FACES",
+           "MAX_MESH_FILE_BYTES", "MAX_TEXTURE_PIXELS"]
+
 #: Largest image side, pixels. Why: Mitsuba's film and our per-pixel truth are dense arrays of
 #: the image; 16384 is the largest side of common sensors and displays times two, and the largest
 #: texture side GPUs address.
@@ -24,10 +29,5 @@ MAX_VIEWS = 1_000_000
 #: rasterised with every edge on a texel boundary; 512 squares of the smallest raster already
 #: make a texture at the image-size limit.
 MAX_BOARD_SIDE = 512
-#: Most triangles of one loaded mesh file (and most bytes of the file). Why: the renderer uploads
-#: the mesh and our truth keeps a float64 copy (~100 bytes per triangle): 50 million triangles
-#: are ~5 GB; a larger scan belongs decimated in the spec.
-MAX_MESH_FACES = 50_000_000
-MAX_MESH_FILE_BYTES = 4 << 30
-#: Most pixels of a procedural or image texture: as an image (2^26), same reason.
-MAX_TEXTURE_PIXELS = MAX_IMAGE_PIXELS
+#: The asset limits (mesh triangles and file bytes, texture pixels) live with the asset builders
+#: that check them: scenegen.assets.checks (MAX_MESH_FACES, MAX_MESH_FILE_BYTES, MAX_TEXTURE_PIXELS).
