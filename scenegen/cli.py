@@ -15,7 +15,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from scenegen.errors import SpecError
+from scenegen.errors import SpecError, os_error_message
 
 EXIT_BAD_INPUT = 2
 #: ``--variant`` choices: scenegen.spec.model.RENDER_VARIANTS (equal, tests/scenegen/test_cli.py)
@@ -176,6 +176,8 @@ def main(argv=None) -> int:
             return _err(str(e))
         if isinstance(e, BrokenPipeError):  # output piped into e.g. `head`
             return 0
+        if isinstance(e, OSError):  # a full disk, a read-only or forbidden folder: one line, exit 2
+            return _err(os_error_message(e))
         raise
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

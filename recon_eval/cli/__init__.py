@@ -40,6 +40,7 @@ import sys
 
 from recon_eval.cli.registry import BY_NAME, COMMANDS
 from recon_eval.errors import InputError
+from scenegen.errors import os_error_message
 
 EXIT_BAD_INPUT = 2
 
@@ -72,7 +73,7 @@ def main(argv=None) -> int:
         print(f"recon-eval: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except OSError as exc:  # unreadable input or unwritable output
-        print(f"recon-eval: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
+        print(f"recon-eval: error: {os_error_message(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
 

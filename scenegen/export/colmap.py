@@ -12,10 +12,10 @@
 """
 from __future__ import annotations
 
-import shutil
 
 import numpy as np
 
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.crossview import VISIBLE
 from scenegen.dataset.layout import view_paths
 from scenegen.export.common import crossview_index, fmt, write
@@ -76,7 +76,7 @@ def export(ds, dest) -> dict:
         img_lines.append(f"{vid[v]} " + " ".join(fmt(x) for x in (*q, *t)) + f" {vid[v]} {v}.png")
         img_lines.append(" ".join(f"{fmt(uv[0])} {fmt(uv[1])} {pid}" for uv, pid in obs[v]))
         (dest / "images").mkdir(exist_ok=True)
-        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
+        copy_file(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     head = "# written by scenegen export (truth; pixels in COLMAP's convention)\n"
     write(dest, "cameras.txt", (head + "# CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]\n" + "\n".join(cam_lines) + "\n").encode())
     write(dest, "images.txt", (head + "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n"

@@ -9,10 +9,10 @@ the right view, 128 = occluded or out of frame, 0 = no surface) and ``calib.txt`
 from __future__ import annotations
 
 import math
-import shutil
 
 import numpy as np
 
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.crossview import VISIBLE
 from scenegen.dataset.layout import stereo_path
@@ -31,7 +31,7 @@ def export(ds, dest) -> dict:
         (dest / name).mkdir(parents=True, exist_ok=True)
         for key, side, dst in (("image", "left", "im0.png"), ("image", "right", "im1.png"),
                                ("disparity_pfm", "left", "disp0.pfm"), ("disparity_pfm", "right", "disp1.pfm")):
-            shutil.copyfile(ds.path(stereo_path(name, key, side)), dest / name / dst)
+            copy_file(ds.path(stereo_path(name, key, side)), dest / name / dst)
         calib = fr.calib
         d0 = fr.disparity("left")
         state = fr.correspondence("left").state

@@ -12,10 +12,10 @@
 from __future__ import annotations
 
 import json
-import shutil
 
 import numpy as np
 
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.layout import view_paths
 from scenegen.export.common import write
 from scenegen.export.errors import ExportError
@@ -49,7 +49,7 @@ def export(ds, dest) -> dict:
         all_intr.append(json.dumps(intr, sort_keys=True))
         frames.append({"file_path": f"images/{v}.png", **intr,
                        "transform_matrix": opengl_cam_to_world(pose).tolist()})
-        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
+        copy_file(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     doc = {"applied_transform": np.eye(4)[:3].tolist(), "frames": frames}
     if len(set(all_intr)) == 1:
         doc.update(json.loads(all_intr[0]))
