@@ -359,6 +359,27 @@ def texture_params(kind: str) -> tuple[str, ...]:
     return tuple(n for n in names if n != "seed")
 
 
+def check_texture_size(kind: str, params) -> tuple[int, int]:
+    """(width, height) in texels the procedural texture ``kind`` would have with ``params``,
+    computed without making it; ValueError when it is not a positive size or exceeds
+    MAX_TEXTURE_PIXELS (so the spec is refused before anything is allocated)."""
+    defaults = {n: p.default for n, p in inspect.signature(TEXTURE_KINDS[kind]).parameters.items()}
+    get = lambda n: params.get(n, defaults.get(n))  # noqa: E731
+    if kind == "checkerboard":
+        try:
+            w, h = (int(get(a)) * int(get("px_per_square")) for a in ("squares_u", "squares_v"))
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError("squares_u, squares_v and px_per_square must be whole numbers") from None
+        return _size_wh((w, h))
+    if "size_px" not in defaults:
+        return (0, 0)
+    w, h = _size_wh(get("size_px"))
+    ss = get("supersample") if "supersample" in defaults else 1
+    if isinstance(ss, (int, float)) and ss > 1 and w * h * ss * ss > MAX_TEXTURE_PIXELS:
+        raise ValueError(f"size_px {w} x {h} with supersample {ss} is more than {MAX_TEXTURE_PIXELS:,} pixels")
+    return w, h
+
+
 def make_texture(kind: str, params: dict | None = None, seed: int = 0) -> np.ndarray:
     """Build a texture by kind name: 'checkerboard', 'noise', 'speckle', 'natural' or 'image'.
 
