@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from recon_eval.cli.common import image_size
 from recon_eval.cli.scored import no_figures, scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.epipolar import (fundamental_degeneracy, fundamental_metrics, homography_mace,
+from recon_eval.metrics.epipolar import (fundamental_degeneracy, fundamental_metrics, homography_degeneracy,
+                                         homography_mace,
                                          homography_summary, pose_error_from_fundamental, sampson_sq_px2,
                                          zhang_f_distance)
 from recon_eval.readers.matrix import read_matrix3
@@ -35,7 +37,7 @@ def fmatrix_arguments(p) -> None:
 def score_fmatrix(a):
     F = read_matrix3(a.f_est, key="F")
     F_gt = read_matrix3(a.f_gt, key="F") if a.f_gt else None
-    size, images, x1 = (tuple(a.size) if a.size else None), None, None
+    size, images, x1 = (image_size(a.size) if a.size else None), None, None
     pinhole_pair = False
     res, inputs = {}, {"f_est": a.f_est, "matches": a.matches, "f_gt": a.f_gt, "dataset": a.dataset, "views": a.views}
     if a.dataset:
@@ -100,7 +102,11 @@ def homography_arguments(p) -> None:
 
 
 def score_homography(a):
-    r = homography_mace(read_matrix3(a.h_est, key="H"), read_matrix3(a.h_gt, key="H"), *a.size)
+    W, H = image_size(a.size)
+    H_gt = read_matrix3(a.h_gt, key="H")
+    if (why := homography_degeneracy(H_gt)) is not None:
+        raise InputError(f"{a.h_gt}: the truth H is degenerate ({why})")
+    r = homography_mace(read_matrix3(a.h_est, key="H"), H_gt, W, H)
     return ({"h_est": a.h_est, "h_gt": a.h_gt, "size": a.size},
             {"homography": r, "summary": homography_summary([r.mace_px])}, no_figures)
 
