@@ -11,14 +11,15 @@ from pathlib import Path
 
 from scenegen.errors import SpecError
 
-#: Largest YAML file read, in bytes (2 MiB). Why: YAML is composed in pure Python (PyYAML's
-#: SafeLoader: the C loader keeps no source text and cannot refuse deep nesting before it
-#: recurses) at about 0.1 MiB per second on a loaded machine, 2-5 times faster on an idle one
-#: (docs/reliability.md has the measurements): a 2 MiB spec (about 40,000 explicit camera poses)
-#: validates in seconds, a 50 MB one would take minutes. The largest bundled spec is under 20 KB;
-#: many views belong in generated placements (orbit, random, line, circle), large geometry in
-#: the mesh files the spec names.
-MAX_SOURCE_BYTES = 2 * 1024 * 1024
+#: Largest YAML file read, in bytes (1 MiB). Why: YAML is composed in pure Python (PyYAML's
+#: SafeLoader: the C loader keeps no source text for messages and cannot refuse deep nesting
+#: before it recurses), in linear time but slowly: measured 0.06 MiB/s for a spec of 6,000
+#: objects on the shared 2-core test machine (docs/reliability.md), several times faster on an
+#: idle one. 1 MiB (about 7,000 objects or 20,000 explicit camera poses) validates in seconds to
+#: tens of seconds; a 50 MB file would take many minutes. The largest bundled spec is 8 KB; many
+#: views belong in generated placements (orbit, random, line, circle), large geometry in the mesh
+#: files the spec names.
+MAX_SOURCE_BYTES = 1024 * 1024
 
 _BOMS = ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
          (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16"))

@@ -174,8 +174,8 @@ case("texture_size_negative", sub("color: 0.5}", "texture: {type: speckle, param
 case("texture_size_text", sub("color: 0.5}", "texture: {type: natural, params: {size_px: big}}}"),
      "size_px must be an int")
 # --- sizes of the file itself ---------------------------------------------------------------------
-case("spec_50mb", append("# " + "x" * (50 * 2**20) + "\n"), "at most 2 MiB are read")
-case("spec_3mb_comment", append("# " + "x" * (3 * 2**20) + "\n"), "at most 2 MiB are read")
+case("spec_50mb", append("# " + "x" * (50 * 2**20) + "\n"), "at most 1 MiB are read")
+case("spec_2mb_comment", append("# " + "x" * (2 * 2**20) + "\n"), "at most 1 MiB are read")
 case("many_look_ats_ok", sub("    orbit: {center: [0, 0, 0], radius_m: 2.0, elevations_deg: [30], count: 3}",
                              "    look_at:\n" + "".join(f"      - {{eye: [{2 + i * 0.01:.2f}, 0.5, 1], target: [0, 0, 0]}}\n"
                                                       for i in range(200))), "OK", 0)

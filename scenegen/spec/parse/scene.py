@@ -93,8 +93,8 @@ def list_section(f: Fields, key: str, parse: Callable, ctx: ParseContext) -> lis
 
 def unique_names(section: Node | None, things, what: str) -> None:
     seen: dict[str, int | None] = {}
-    for i, thing in enumerate(things):
-        item = section.items()[i]
+    items = section.items() if things else []  # once: linear in the number of things
+    for item, thing in zip(items, things):
         name_node = item.as_mapping().get("name") or item
         if thing.name in seen:
             raise name_node.error(f"duplicate {what} name {thing.name!r} (first at line "
