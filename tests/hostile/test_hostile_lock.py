@@ -169,3 +169,35 @@ def test_an_unreadable_lock_file_is_reported_not_broken(tmp_path, no_flock):
     (tmp_path / LOCK_NAME).write_bytes(b"\x00garbage")
     with pytest.raises(DatasetLockedError, match="an unknown process"):
         DatasetLock.acquire(tmp_path)
+
+
+KILLED = TINY.replace("count: 2}", "count: 24}")
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("workers", [None, 2])
+def test_kill_9_mid_render_then_resume_takes_over_the_stale_lock_and_gives_the_bytes_of_one_run(tmp_path, workers):
+    import time
+    from scenegen.cli import main
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(KILLED)
+    ref = tmp_path / "ref"
+    assert main(["render", str(spec), "-o", str(ref), "-q"]) == 0
+    out = tmp_path / "out"
+    argv = [sys.executable, "-m", "scenegen.cli", "render", str(spec), "-o", str(out), "-q"]
+    if workers:
+        argv += ["--workers", str(workers)]
+    p = subprocess.Popen(argv, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    journal = out / "manifest.journal"
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and p.poll() is None:
+        if journal.is_file() and b'"op":"view"' in journal.read_bytes():
+            break
+        time.sleep(0.05)
+    assert p.poll() is None, "the run ended before it could be killed"
+    os.killpg(p.pid, signal.SIGKILL)  # the client and its Dask workers
+    p.wait(timeout=60)
+    assert (out / LOCK_NAME).is_file()  # left by the killed run: stale
+    assert main(["render", str(spec), "-o", str(out), "--resume", "-q"]) == 0
+    assert all_bytes(out) == all_bytes(ref)
