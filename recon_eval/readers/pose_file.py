@@ -11,14 +11,13 @@ A bare matrix is read in ``convention`` (default ``cam_from_world``, OpenCV ``so
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.readers.npy import read_npy
-from recon_eval.readers.text import read_text
+from recon_eval.readers.text import json_document, read_text
 from scenegen.geometry.rotation import is_rotation
 
 CONVENTIONS = ("cam_from_world", "world_from_cam")
@@ -47,10 +46,7 @@ def read_pose(path, convention: str = "cam_from_world") -> tuple[np.ndarray, np.
     if p.suffix.lower() == ".npy":
         R, t = _from_matrix(read_npy(p), p)
     elif p.suffix.lower() == ".json":
-        try:
-            obj = json.loads(read_text(p, "a camera pose as JSON"))
-        except (json.JSONDecodeError, RecursionError) as exc:  # RecursionError: nested too deeply
-            raise InputError(f"{p}: invalid JSON ({exc})") from None
+        obj = json_document(read_text(p, "a camera pose as JSON"), p, "a camera pose")
         if isinstance(obj, dict):
             for key in CONVENTIONS:
                 if key in obj:

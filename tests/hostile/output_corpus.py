@@ -71,6 +71,8 @@ case("pnp_npy_text", "pnp", N, "1 0 0 0\n", "not a readable .npy array")
 case("pnp_npy_shape", "pnp", N, npy_bytes(np.eye(2)), "12 or 16 numbers")
 case("pnp_npy_pickle", "pnp", N, npy_bytes(np.array([{"R": 1}], dtype=object)), "not a readable .npy array")
 case("pnp_npy_strings", "pnp", N, npy_bytes(np.array(["a", "b"])), "expected a numeric array")
+case("pnp_duplicate_R", "pnp", J, '{"R": [[1,0,0],[0,1,0],[0,0,1]], "R": [[0,-1,0],[1,0,0],[0,0,1]], "t": [0,0,1]}',
+     "duplicate key 'R' in a camera pose")
 case("pnp_directory", "pnp", J, None, "no such file")
 case("pnp_missing", "pnp", "absent.json", "<absent>", "no such file")
 # --- homography: a 3x3 matrix, estimate or truth -----------------------------------------------------
@@ -85,6 +87,8 @@ case("h_binary", "homography", "h.txt", BINARY, "not a UTF-8 text file")
 case("h_json_no_key", "homography", "h.json", {"F": np.eye(3).tolist()}, "an object with key 'H'")
 case("h_json_deep", "homography", "h.json", DEEP_JSON, "invalid JSON")
 case("h_json_invalid", "homography", "h.json", "[[1, 0", "invalid JSON")
+case("h_json_duplicate", "homography", "h.json", '{"H": [[1,0,0],[0,1,0],[0,0,1]], "H": [[2,0,0],[0,1,0],[0,0,1]]}',
+     "duplicate key 'H' in a 3x3 matrix")
 case("h_json_ragged", "homography", "h.json", [[1, 0, 0], [0, 1], [0, 0, 1]], "expected a 3x3 array of numbers")
 case("h_json_strings", "homography", "h.json", [["x"] * 3] * 3, "expected a 3x3 array of numbers")
 case("h_npy_shape", "homography", "h.npy", npy_bytes(np.eye(4)), "expected an array of shape (3, 3)")
@@ -147,6 +151,11 @@ case("calib_garbage", "calibration", "est.yaml", "%YAML:1.0\n---\n: : :\n", "not
 case("calib_utf16", "calibration", "est.yaml", CAL.format(d="").encode("utf-16"), "not a UTF-8 text file")
 case("calib_binary", "calibration", "est.yaml", BINARY, "not a UTF-8 text file")
 case("calib_json_deep", "calibration", "est.json", DEEP_JSON, "nested deeper than 64 levels")
+case("calib_duplicate_matrix", "calibration", "est.yaml", CAL.format(d="") + CAL.format(d="").split("---\n")[1]
+     .split("image_height: 60\n")[1], "duplicate key 'camera_matrix' (first given at line 5)")
+case("calib_duplicate_width", "calibration", "est.yaml", CAL.format(d="").replace("image_height: 60", "image_height: 60\n"
+     "image_width: 800"), "duplicate key 'image_width' (first given at line 3)")
+case("calib_duplicate_json", "calibration", "est.json", '{"image_width": 80, "image_width": 90}', "duplicate key 'image_width'")
 case("calib_missing", "calibration", "absent.yaml", "<absent>", "no such file")
 # --- gate files (YAML through scenegen.located_yaml) ----------------------------------------------------
 G = "version: 1\ngates:\n  - method: m\n    metric: rmse_m\n    op: '<='\n    threshold: 0.1\n"
