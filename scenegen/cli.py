@@ -191,6 +191,9 @@ def _bad_input_errors() -> tuple[type, ...]:
 
 
 def main(argv=None) -> int:
+    bad = next((a for a in (sys.argv[1:] if argv is None else argv) if "\x00" in str(a)), None)
+    if bad is not None:  # no path, name or option can hold one
+        return _err(f"the argument {str(bad)!r} contains a NUL byte")
     args = build_parser().parse_args(argv)
     try:
         return args.fn(args)

@@ -66,6 +66,10 @@ def build_parser(argv=None, *, full: bool = False) -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Run one command; its exit code: 0 ok, 1 a gate failed, 2 bad input (no traceback)."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    bad = next((a for a in argv if "\x00" in str(a)), None)
+    if bad is not None:  # no path, name or option can hold one
+        print(f"recon-eval: error: the argument {str(bad)!r} contains a NUL byte", file=sys.stderr)
+        return EXIT_BAD_INPUT
     args = build_parser(argv).parse_args(argv)  # argparse itself exits with code 2 on bad usage
     try:
         return _family(args.command).COMMANDS[args.command].run(args)

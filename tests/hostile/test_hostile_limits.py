@@ -76,7 +76,13 @@ def test_a_large_spec_is_refused_by_its_size_at_once(tmp_path):
 def test_nul_byte_in_a_command_line_path_names_it(tmp_path):
     from scenegen.cli import main
     code, _, err = run_cli(main, ["validate", "sce\x00ne.yaml"])
-    assert code == 2 and "the spec file path contains a NUL byte" in err and "Traceback" not in err
+    assert code == 2 and "'sce\\x00ne.yaml' contains a NUL byte" in err and "Traceback" not in err
+    from recon_eval.cli import main as recon_main
+    code, _, err = run_cli(recon_main, ["pnp", "a\x00b.json", tmp_path / "gt.json"])
+    assert code == 2 and "'a\\x00b.json' contains a NUL byte" in err
+    from scenegen.located_yaml.source import read_source
+    with pytest.raises(SpecError, match="the spec file path contains a NUL byte"):
+        read_source("sce\x00ne.yaml", "spec file")  # the Python API too
 
 
 def test_json_report_into_a_folder_names_the_folder_not_a_temporary_file(tmp_path):

@@ -19,7 +19,6 @@ from hostile_data import run_cli, write_dataset  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parents[1] / "scenegen" / "dataset"))
 from test_dataset import all_bytes, new_writer  # noqa: E402
 
-from scenegen import dataset as ds  # noqa: E402
 from scenegen.dataset import lock as lock_module  # noqa: E402
 from scenegen.dataset.lock import LOCK_NAME, DatasetLock, DatasetLockedError  # noqa: E402
 
