@@ -3,6 +3,9 @@ as a self-contained HTML table (the JSON is :func:`recon_eval.ci.leaderboard.run
 from __future__ import annotations
 
 import html
+import re
+
+_NAME = re.compile(r"[A-Za-z0-9_.-]+")
 
 
 def _fmt(v) -> str:
@@ -24,14 +27,19 @@ def rows(doc: dict) -> list[tuple[str, str, str]]:
 
 def markdown_text(text: str) -> str:
     """``text`` as plain Markdown table-cell text: HTML escaped (no raw ``<script>`` from a name
-    or an error message), Markdown's own marks and the cell separator backslash-escaped, one line."""
+    or an error message), the cell separator and code marks backslash-escaped, on one line."""
     text = html.escape(" ".join(str(text).split()), quote=False)
-    return "".join("\\" + c if c in "\\`*_[]|#" else c for c in text)
+    return "".join("\\" + c if c in "\\`|" else c for c in text)
+
+
+def markdown_name(name: str) -> str:
+    """A scene or method name as a code span when it is made of name characters, else as text."""
+    return f"`{name}`" if _NAME.fullmatch(str(name)) else markdown_text(name)
 
 
 def markdown(doc: dict) -> str:
     lines = ["| scene | method | metrics |", "|---|---|---|"]
-    lines += [f"| {markdown_text(s)} | {markdown_text(m)} | {markdown_text(ms)} |" for s, m, ms in rows(doc)]
+    lines += [f"| {markdown_name(s)} | {markdown_name(m)} | {markdown_text(ms)} |" for s, m, ms in rows(doc)]
     return "\n".join(lines) + "\n"
 
 
