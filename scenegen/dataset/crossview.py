@@ -176,8 +176,8 @@ class CrossviewIndex:
         if not isinstance(targets, list) or not all(isinstance(v, str) for v in targets):
             raise ValueError("targets: expected a list of view names")
         pairs, flow = pairs_of("pairs", "i", "j"), pairs_of("flow", "i", "j")
-        stereo, files = pairs_of("stereo", "left_view", "right_view"), d.get("files", ())
-        if not isinstance(files, list) or not all(isinstance(r, str) for r in files):
+        stereo, files = pairs_of("stereo", "left_view", "right_view"), d.get("files", [])
+        if not isinstance(files, (list, tuple)) or not all(isinstance(r, str) for r in files):
             raise ValueError("files: expected a list of relative paths")
         check_listed_names("index", views=[v for p in pairs + flow + stereo for v in p] + targets,
                            paths=files)  # names become paths: checked before any is used
