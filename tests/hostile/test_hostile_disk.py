@@ -119,3 +119,21 @@ def test_render_on_a_full_disk_then_resume_on_a_larger_one_gives_the_bytes_of_on
     shutil.copytree(disk / "ds", moved)
     assert main(["render", str(spec), "-o", str(moved), "--resume", "-q"]) == 0
     assert all_bytes(moved) == all_bytes(ref)
+
+
+@pytest.mark.parametrize("code_,advice", [(errno.EACCES, "permission denied: write to a folder you may write to"),
+                                          (errno.EDQUOT, "the disk quota is exceeded")])
+def test_permission_and_quota_errors_are_one_line_naming_the_target(tmp_path, monkeypatch, code_, advice):
+    """Root ignores permissions, so the error is planted where every byte is written
+    (scenegen.dataset.files.write_payload): the message names the target file, not its temporary."""
+    from scenegen.cli import main
+    from scenegen.dataset import files
+    src = tmp_path / "src"
+    write_dataset(src)
+
+    def refuse(f, data):
+        raise OSError(code_, "refused")
+    monkeypatch.setattr(files, "write_payload", refuse)
+    code, _, err = run_cli(main, ["export", src, "--format", "tum", "-o", tmp_path / "tum"])
+    assert code == 2 and len(err.strip().splitlines()) == 1 and advice in err and "scenegen-tmp" not in err
+    assert str(tmp_path / "tum") in err and not list((tmp_path / "tum").rglob("*.scenegen-tmp"))
