@@ -106,7 +106,11 @@ class Dataset:
             if not (isinstance(doc, dict) and isinstance(doc.get("view_order"), list)
                     and isinstance(doc.get("views"), dict)):
                 raise DatasetError(f"{p}: expected a JSON object with 'view_order' (a list) and 'views'")
-            _check_names(str(p), views=list(doc["view_order"]) + list(doc["views"]))
+            infos = [e for e in doc["views"].values() if isinstance(e, dict)]
+            _check_names(str(p), views=list(doc["view_order"]) + list(doc["views"]),
+                         names=[(what, e[k]) for e in infos for k, what in
+                                (("camera_name", "camera"), ("rig", "rig"), ("rig_member", "rig member"))
+                                if e.get(k) is not None])
             self._cameras = doc
         return self._cameras
 
@@ -270,9 +274,9 @@ class Dataset:
         return self._crossview
 
 
-def _check_names(source: str, *, views=(), paths=()) -> None:
+def _check_names(source: str, *, views=(), paths=(), names=()) -> None:
     """Every name a dataset file lists is checked once, when the file is read (DatasetError)."""
     try:
-        check_listed_names(source, views=views, paths=paths)
+        check_listed_names(source, views=views, paths=paths, names=names)
     except ValueError as e:
         raise DatasetError(str(e)) from None

@@ -131,7 +131,7 @@ case("duplicate_object_name", sub("  - name: ball", "  - name: floor"), "floor")
 case("unknown_top_key", append("renderer: {spp: 4}\n"), "unknown key 'renderer'")
 case("unknown_object_key", sub("    transform:", "    transfrom:"), "unknown key 'transfrom'")
 case("unknown_render_key", sub("spp: 4", "spp: 4, spps: 8"), "unknown key 'spps'")
-case("empty_file", whole(""), "")
+case("empty_file", whole(""), "got an empty document")
 case("top_level_list", whole("- a\n- b\n"), "a mapping at the top level")
 case("top_level_scalar", whole("hello\n"), "a mapping at the top level")
 case("bad_indent", whole("name: x\n  objects: [\n"), "invalid YAML")
@@ -151,7 +151,7 @@ case("object_name_space", sub("  - name: ball", "  - name: 'my ball'"), "letters
 case("object_name_number", sub("  - name: ball", "  - name: 12"), "expected an object name")
 case("scene_name_dots", sub("name: corpus", "name: '..'"), "letters, digits")
 case("scene_name_5000", sub("name: corpus", "name: " + "s" * 5000), "at most 128 characters")
-case("camera_name_slash", sub("  cam: {", "  'a/b': {"), "")
+case("camera_name_slash", sub("  cam: {", "  'a/b': {"), "expected a camera name made of letters")
 case("light_name_null_is_absent", sub("{type: point,", "{type: point, name: null,"), "OK", 0)
 # --- files the spec names -----------------------------------------------------------------------
 MESH = "  - name: thing\n    mesh: {path}\n    material: {{type: diffuse, color: 0.5}}\n"

@@ -144,3 +144,13 @@ def test_hostile_gate_files_fail_with_one_line(tmp_path, payload, fragment):
     gate.write_bytes(payload)
     code, _, err = run_cli(recon_main, ["gate", gate, tmp_path / "result.json"])
     assert code == 2 and fragment in err and str(gate) in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_crafted_camera_name_cannot_name_a_file_outside(dataset):
+    """Runners name files after a view's camera (calibration_<camera>.yaml): checked on read too."""
+    cams = json.loads((dataset / "cameras.json").read_text())
+    cams["views"][VIEWS[0]]["camera_name"] = "../../calib_escape"
+    (dataset / "cameras.json").write_text(json.dumps(cams))
+    resign(dataset)
+    with pytest.raises(ds.DatasetError, match="cameras.json: lists an invalid camera name"):
+        ds.Dataset(dataset).views_of_camera("cam0")
