@@ -22,7 +22,9 @@ from recon_eval.report.html import Figure
 def calibration_arguments(p) -> None:
     p.add_argument("est", help="estimated calibration, OpenCV YAML/JSON (camera_matrix/K, distortion_coefficients/D)")
     p.add_argument("gt", help="truth: a dataset folder (camera of --view) or an OpenCV YAML/JSON calibration")
-    p.add_argument("--view", help="dataset truth: the view whose camera is the truth (default: the first view)")
+    p.add_argument("--view", help="dataset truth: the view whose camera is the truth")
+    p.add_argument("--camera", help="dataset truth: the spec camera that was calibrated (its first view gives the "
+                                    "truth and the held-out points); default: the dataset's only camera")
     p.add_argument("--est-model", choices=["opencv", "fisheye"], help="override the estimate's distortion model")
     p.add_argument("--grid", type=int, nargs=2, metavar=("NX", "NY"),
                    help="projection-difference grid (default 60 x 40; mrcal_projection_diff: mrcal's 60 x "
@@ -38,13 +40,16 @@ def score_calibration(a):
     held_out = None
     if is_dataset(a.gt):
         ds = read_dataset(a.gt)
-        view = a.view or ds.views[0]
+        view = calibration_view(ds, a.view, a.camera)
         gt, pose = ds.camera(view)
         uv, X = ds.points_at_pixels(view, max_points=a.points)
         held_out = (pose, X, uv)
-        inputs.update(view=view, gt_kind="scenegen-dataset camera", held_out_points=len(X))
+        inputs.update(view=view, camera=ds.view_info(view).get("camera_name"), gt_kind="scenegen-dataset camera",
+                      held_out_points=len(X))
     else:
         needs_dataset_for_view(a)
+        if a.camera:
+            raise InputError(f"--camera needs a dataset truth; {a.gt} is not a dataset folder")
         gt = read_opencv_calibration(a.gt)
         inputs["gt_kind"] = "OpenCV calibration file"
     inputs["gt_model"] = gt.model
@@ -73,6 +78,27 @@ def score_calibration(a):
         return figs
 
     return inputs, res, figures
+
+
+def calibration_view(ds, view: str | None, camera: str | None) -> str:
+    """The view whose camera is the calibration truth: ``view``, else the first view of spec camera
+    ``camera``, else the first view when every view has the same camera; InputError otherwise."""
+    if view is not None:
+        if camera is not None and ds.view_info(view).get("camera_name") != camera:
+            raise InputError(f"--view {view} was taken with camera {ds.view_info(view).get('camera_name')!r}, "
+                             f"not --camera {camera!r}")
+        return ds.check_view(view)
+    names = list(dict.fromkeys(ds.view_info(v).get("camera_name") for v in ds.views))
+    if camera is not None:
+        views = ds.views_of_camera(camera)
+        if not views:
+            raise InputError(f"{ds.root}: no view of camera {camera!r} (cameras: {', '.join(map(str, names))})")
+        return views[0]
+    first = ds.camera(ds.views[0])[0]
+    if any(ds.camera(v)[0] != first for v in ds.views[1:]):
+        raise InputError(f"{ds.root}: the views have different cameras ({', '.join(map(str, names))}): pass --camera "
+                         f"NAME (or --view VIEW) for the one that was calibrated")
+    return ds.views[0]
 
 
 # --- PnP --------------------------------------------------------------------------------------

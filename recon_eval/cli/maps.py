@@ -10,7 +10,7 @@ import numpy as np
 
 from recon_eval.cli.common import dataset_view, needs_dataset_for_view, same_shape
 from recon_eval.cli.scored import scored
-from recon_eval.errors import InputError
+from recon_eval.errors import InputError, NotApplicable
 from recon_eval.metrics.depth import CROPS, DepthAlignment, eigen_depth_metrics
 from recon_eval.metrics.stereo import eth3d_two_view, kitti_d1, middlebury
 from recon_eval.readers.kitti_png import read_kitti_obj_map
@@ -27,6 +27,11 @@ def disparity_arguments(p) -> None:
     p.add_argument("gt", help="truth disparity (occ / all pixels), or a dataset folder with --view")
     p.add_argument("--view", help="dataset truth: the left view of a rectified stereo pair")
     p.add_argument("--right-view", help="dataset truth: its right view (default: the other member of the rig)")
+    p.add_argument("--truth", choices=DISPARITY_TRUTHS, default="auto",
+                   help="dataset truth: view = the views' own disparity (needs a rectified rig: equal pinhole "
+                        "cameras side by side), rectified = the rectified stereo frame of the cross-view truth "
+                        "(crossview/stereo/VIEW/disp_left.pfm, with its non-occlusion mask), auto (default) = view "
+                        "when the rig is rectified, else rectified")
     p.add_argument("--gt-noc", help="non-occluded truth (KITTI) or non-occlusion mask source (.png/.pfm/.npy/.exr; "
                                     "a Middlebury mask0nocc.png: 255 = evaluated)")
     p.add_argument("--obj-map", help="KITTI foreground map PNG")
@@ -40,12 +45,11 @@ def disparity_arguments(p) -> None:
 
 def score_disparity(a):
     est = read_map(a.est, "disparity")
-    gt_kind = "file"
+    gt_kind, noc_mask = "file", None
     if is_dataset(a.gt):
         ds = read_dataset(a.gt)
         view = dataset_view(ds, a.view, "a disparity truth")
-        gt = ds.disparity(view, a.right_view)
-        gt_kind = f"scenegen-dataset view {view}: fx * baseline / depth_z"
+        gt, noc_mask, gt_kind = dataset_disparity(ds, view, a.right_view, a.truth)
     else:
         needs_dataset_for_view(a)
         gt = read_map(a.gt, "disparity")
@@ -53,10 +57,14 @@ def score_disparity(a):
     mask = None
     if a.gt_noc and a.benchmark != "kitti" and is_middlebury_mask(a.gt_noc):
         mask, noc = read_middlebury_mask(a.gt_noc), None
-    else:
-        noc = read_map(a.gt_noc, "disparity") if a.gt_noc else None
+    elif a.gt_noc:
+        noc = read_map(a.gt_noc, "disparity")
+    else:  # the rectified frame's own non-occlusion mask (None for a view truth)
+        noc = None if noc_mask is None else np.where(noc_mask, gt, np.nan)
     inputs = {"est": a.est, "gt": a.gt, "gt_kind": gt_kind, "gt_noc": a.gt_noc, "obj_map": a.obj_map,
               "benchmark": a.benchmark}
+    if noc_mask is not None and not a.gt_noc:
+        inputs["gt_noc"] = "the rectified frame's non-occlusion mask (disp_left_noc.png)"
     if a.benchmark == "kitti":
         obj = [read_kitti_obj_map(a.obj_map)] if a.obj_map else None
         res = {"kitti_d1": kitti_d1([est], [gt], None if noc is None else [noc], obj)}
@@ -82,6 +90,35 @@ def score_disparity(a):
         ]
 
     return inputs, res, figures
+
+
+#: Which dataset disparity truth ``disparity --truth`` scores against.
+DISPARITY_TRUTHS = ("auto", "view", "rectified")
+
+
+def dataset_disparity(ds, view: str, right: str | None, which: str):
+    """(truth disparity (H, W) px, non-occlusion mask (H, W) bool or None, what it is) of a dataset
+    view: the views' own truth (``which`` "view": a rectified rig), the rectified stereo frame of
+    the cross-view truth ("rectified"), or the first of the two that exists ("auto")."""
+    why = "--truth rectified"
+    if which in ("auto", "view"):
+        try:
+            return ds.disparity(view, right), None, f"scenegen-dataset view {view}: fx * baseline / depth_z"
+        except InputError as exc:
+            if which == "view":
+                raise
+            why = str(exc)
+    if right is not None:
+        raise InputError(f"--right-view: a rectified stereo frame has its own right image; drop --right-view "
+                         f"(the views' own truth failed: {why})")
+    try:
+        gt = ds.stereo_disparity(view)
+    except NotApplicable as exc:
+        if which == "rectified":
+            raise InputError(str(exc)) from None
+        raise InputError(f"{ds.root}: no disparity truth for view {view!r}: {why}; and no rectified stereo frame "
+                         f"({exc})") from None
+    return gt, ds.stereo_noc_mask(view), f"scenegen-dataset rectified stereo frame crossview/stereo/{view}"
 
 
 def _middlebury_ndisp(a, gt, dataset_truth: bool):

@@ -2,13 +2,16 @@
 ``score(args) -> (inputs, results, figures)`` (provenance, metric name -> result dataclass, and a
 function returning the HTML :class:`recon_eval.report.html.Figure` list, called only for
 ``--html``); :func:`scored` makes it a command that prints the table and writes ``--json`` and
-``--html``."""
+``--html``. ``--method`` and ``--scene`` label the result for ``recon-eval gate`` and the
+leaderboard (``inputs.method``, ``inputs.scene``); the scene defaults to the dataset's own when
+the truth is a scenegen dataset."""
 from __future__ import annotations
 
 from typing import Callable
 
 from recon_eval.cli.registry import Impl
 from recon_eval.errors import InputError
+from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report.document import document, print_table, write_json_atomic
 from recon_eval.report.html import render_html, write_html_atomic
 
@@ -26,10 +29,15 @@ def scored(arguments: Callable, score: Callable) -> Impl:
         p.add_argument("--html", metavar="OUT",
                        help="write a self-contained HTML report with figures (needs matplotlib)")
         p.add_argument("--quiet", action="store_true", help="do not print the table")
+        p.add_argument("--method", metavar="NAME", help="the method name written into the JSON (inputs.method), "
+                                                        "for gates and leaderboards")
+        p.add_argument("--scene", metavar="NAME", help="the scene name written into the JSON (inputs.scene; "
+                                                       "default: the dataset's scene when the truth is a dataset)")
         arguments(p)
 
     def run(a) -> int:
         inputs, results, figures = score(a)
+        inputs = label_inputs(inputs, a)
         if not a.quiet:
             print_table(f"recon-eval {a.command}", results)
         if a.json:
@@ -43,3 +51,25 @@ def scored(arguments: Callable, score: Callable) -> Impl:
         return 0
 
     return Impl(add, run)
+
+
+#: Arguments of scored commands that may name the truth dataset (its scene labels the result).
+DATASET_ARGUMENTS = ("dataset", "gt")
+
+
+def label_inputs(inputs: dict, a) -> dict:
+    """``inputs`` with ``method`` and ``scene`` set from ``--method``/``--scene``, the scene else
+    from the truth dataset (the first of :data:`DATASET_ARGUMENTS` that is one)."""
+    out = dict(inputs)
+    if getattr(a, "method", None):
+        out["method"] = a.method
+    scene = getattr(a, "scene", None)
+    for name in DATASET_ARGUMENTS:
+        if scene:
+            break
+        value = getattr(a, name, None)
+        if isinstance(value, str) and is_dataset(value):
+            scene = read_dataset(value).scene_name
+    if scene:
+        out["scene"] = scene
+    return out

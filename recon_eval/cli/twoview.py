@@ -2,22 +2,23 @@
 (docs/metrics.md, "Fundamental matrices and homographies")."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from recon_eval.cli.common import image_size
 from recon_eval.cli.scored import no_figures, scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.epipolar import (fundamental_degeneracy, fundamental_metrics, homography_degeneracy,
-                                         homography_mace,
-                                         homography_summary, pose_error_from_fundamental, sampson_sq_px2,
-                                         zhang_f_distance)
+from recon_eval.metrics.epipolar import (fundamental_degeneracy, homography_degeneracy, homography_mace,
+                                         homography_summary, sampson_sq_px2)
 from recon_eval.readers.matrix import read_matrix3
-from recon_eval.readers.npy import read_npy
+from recon_eval.readers.npy import read_mask, read_npy
 from recon_eval.readers.registry import read_image
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
-from scenegen.geometry.twoview import fundamental
+from recon_eval.tasks.fmatrix_pair import PIXELS, PairTruth, pair_truth, score_pair
+from scenegen.dataset.layout import MATCH_KINDS
 
 
 # --- fundamental matrix -----------------------------------------------------------------------
@@ -30,53 +31,81 @@ def fmatrix_arguments(p) -> None:
     p.add_argument("--views", nargs=2, metavar=("VIEW1", "VIEW2"),
                    help="the two dataset views (F maps 1 -> 2); their truth correspondences need the pair in the "
                         "spec's crossview.pairs")
+    p.add_argument("--pixels", choices=PIXELS, default="undistorted",
+                   help="dataset truth: the pixels F (and --matches rows) are for: undistorted (default; F exists only there: the "
+                        "dataset's truth F, Zhang distance and pose via K) or distorted (the raw pixels of the "
+                        "stored images; no truth F for cameras with distortion). Same for pinhole cameras")
+    p.add_argument("--match-set", choices=list(MATCH_KINDS),
+                   help="dataset truth: the labelled putative matches of the pair (crossview/matches) whose rows "
+                        "--inliers labels")
+    p.add_argument("--inliers", metavar="MASK",
+                   help="the estimator's inlier mask (.npy bool / 0-1, or text), one value per row of --match-set "
+                        "or of --labels: inlier precision and recall")
+    p.add_argument("--labels", metavar="LABELS",
+                   help="without a dataset: the truth inlier labels (.npy bool / 0-1) of the rows --inliers labels")
     p.add_argument("--max-matches", type=int, default=20000, help="dataset correspondences sampled (seeded)")
     p.add_argument("--images", nargs=2, metavar=("IMG1", "IMG2"), help="images for the HTML epipolar-line figure")
 
 
+def _dataset_labels(ds, v1, v2, kind):
+    for ms in ds.match_sets(v1, v2):
+        if ms.kind == kind:
+            return ms.inliers
+    raise InputError(f"{ds.root}: views {v1!r} -> {v2!r} have no {kind!r} match set (crossview/matches)")
+
+
 def score_fmatrix(a):
     F = read_matrix3(a.f_est, key="F")
-    F_gt = read_matrix3(a.f_gt, key="F") if a.f_gt else None
-    size, images, x1 = (image_size(a.size) if a.size else None), None, None
-    pinhole_pair = False
-    res, inputs = {}, {"f_est": a.f_est, "matches": a.matches, "f_gt": a.f_gt, "dataset": a.dataset, "views": a.views}
+    inputs = {"f_est": a.f_est, "matches": a.matches, "f_gt": a.f_gt, "dataset": a.dataset, "views": a.views}
+    labels = images = None
+    if a.size:
+        image_size(a.size)  # two positive numbers (InputError otherwise)
     if a.dataset:
         if not a.views:
             raise InputError("--dataset needs --views VIEW1 VIEW2")
+        if a.labels:
+            raise InputError("--labels is for a truth without a dataset; with --dataset give --match-set KIND")
         ds = read_dataset(a.dataset)
         v1, v2 = a.views
-        (c1, p1), (c2, p2) = ds.camera(v1), ds.camera(v2)
-        rel = p2 @ p1.inverse()  # cam2_from_cam1
-        if not a.matches:
-            x1, x2 = ds.correspondences(v1, v2, max_points=a.max_matches)
-            if len(x1) == 0:
-                raise InputError(f"{a.dataset}: views {v1!r} and {v2!r} share no visible truth point")
-            inputs["matches"] = f"dataset truth correspondences ({len(x1)} visible, seeded sample)"
-        pinhole_pair = c1.model == "pinhole" and c2.model == "pinhole"  # F exists for undistorted pixels only
-        if pinhole_pair:
-            if F_gt is None:
-                F_gt = fundamental(c1.K, c2.K, rel)
-                inputs["f_gt"] = "dataset cameras: K2^-T [t]x R K1^-1"
-        else:
-            inputs["f_gt_note"] = "distorted cameras have no fundamental matrix: no truth F, no pose via K"
-        if size is None:
-            size = (c1.width, c1.height)
+        truth = pair_truth(ds, v1, v2, pixels=a.pixels, max_points=a.max_matches, correspondences=not a.matches)
+        if a.matches:  # the user's own truth correspondences replace the dataset's
+            m = read_npy(a.matches, (None, 4))
+            truth = replace(truth, x1=m[:, :2], x2=m[:, 2:], notes={**truth.notes, "correspondences": a.matches})
+        if a.f_gt:
+            truth = replace(truth, F_gt=read_matrix3(a.f_gt, key="F"), notes={**truth.notes, "f_gt": a.f_gt})
+        if a.size:
+            truth = replace(truth, size1=tuple(a.size), size2=tuple(a.size))
+        if a.match_set:
+            labels = _dataset_labels(ds, v1, v2, a.match_set)
+        inputs.update(truth.notes, matches=truth.notes["correspondences"], match_set=a.match_set)
         images = (ds.image(v1), ds.image(v2))
-    if x1 is None:
+    else:
+        if a.match_set:
+            raise InputError("--match-set needs --dataset DIR --views V1 V2")
         if not a.matches:
             raise InputError("fmatrix needs --matches M.npy or --dataset DIR --views V1 V2")
         m = read_npy(a.matches, (None, 4))
-        x1, x2 = m[:, :2], m[:, 2:]
-    res["fundamental"] = fundamental_metrics(F, x1, x2)
-    if F_gt is not None:
-        if not size:
+        F_gt = read_matrix3(a.f_gt, key="F") if a.f_gt else None
+        if F_gt is not None and not a.size:
             raise InputError("--f-gt needs --size W H for Zhang's F-distance")
-        res["zhang_f_distance"] = zhang_f_distance(F, F_gt, size)
-    if pinhole_pair:
-        res["pose_via_K"] = pose_error_from_fundamental(F, c1.K, c2.K, x1, x2, rel.R, rel.t)
+        size = tuple(a.size) if a.size else None
+        eye = np.full((3, 3), np.nan)
+        truth = PairTruth(m[:, :2], m[:, 2:], F_gt, eye, eye, eye, np.full(3, np.nan), size, size, "as given", {})
+        labels = read_mask(a.labels, len(m)) if a.labels else None  # one label per row of --matches
+    inliers = None
+    if a.inliers:
+        if labels is None:
+            raise InputError("--inliers needs the truth labels of its rows: --match-set KIND (dataset) or --labels")
+        inliers = read_mask(a.inliers, len(labels))
+    elif a.labels:
+        raise InputError("--labels needs --inliers MASK (the estimator's mask over the same rows)")
+    res = score_pair(F, truth, inliers=inliers, labels=labels)
+    if not a.dataset:
+        del res["pose_via_K"]  # no cameras without a dataset
     if a.images:
         images = tuple(read_image(p) for p in a.images)
-    inputs["size"] = size
+    inputs["size"] = truth.size1
+    x1, x2, F_gt = truth.x1, truth.x2, truth.F_gt
 
     def figures():
         figs = []

@@ -32,8 +32,9 @@ from scenegen.dataset import CAMERAS, MANIFEST, Dataset, DatasetError
 from scenegen.dataset.crossview import VISIBLE, Correspondence, CrossviewIndex, MatchSet
 from scenegen.dataset.crossview_reader import TwoViewTruth
 from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, correspondence_path, flow_path,
-                                     mesh_path, view_paths)
+                                     mesh_path, stereo_path, twoview_path, view_paths)
 from scenegen.geometry.conventions import in_image
+from scenegen.geometry.twoview import fundamental
 
 #: Rectification tolerances of :meth:`DatasetTruth.disparity`: rotations equal to 1e-9 (JSON
 #: round-trips float64 exactly; the renderer places both members by the same rig rotation), and
@@ -300,6 +301,25 @@ class DatasetTruth:
     def twoview(self, view1: str, view2: str) -> TwoViewTruth:
         """The two-view geometry of a crossview pair (relative pose, E, F, plane homographies)."""
         return self._read(self._ds.crossview.twoview, self.check_view(view1), self.check_view(view2))
+
+    def truth_fundamental(self, view1: str, view2: str):
+        """``(F (3, 3) or None, source)``: the truth F of view1 -> view2 for UNDISTORTED OpenCV pixels,
+        the stored ``crossview/twoview/<i>/<j>.json`` when the dataset has it, else
+        ``K2^-T [t]x R K1^-1`` of cameras.json; None for a zero baseline (one camera centre)."""
+        self.check_view(view1)
+        self.check_view(view2)
+        if self._ds.has(twoview_path(view1, view2)):
+            return self.twoview(view1, view2).F, str(twoview_path(view1, view2))
+        (c1, p1), (c2, p2) = self.camera(view1), self.camera(view2)
+        rel = p2 @ p1.inverse()
+        if np.linalg.norm(rel.t) == 0.0:
+            return None, f"{CAMERAS}: one camera centre"
+        return fundamental(c1.K, c2.K, rel), f"{CAMERAS}: K2^-T [t]x R K1^-1"
+
+    def stereo_image_path(self, left_view: str, side: str) -> Path:
+        """The rectified image file of one side of a stereo frame (for tools that read files)."""
+        self._stereo(left_view)
+        return self._ds.path(stereo_path(left_view, "image", side))
 
     def match_sets(self, view1: str, view2: str) -> Iterator[MatchSet]:
         """The labelled match sets of a pair that the dataset holds, synthetic first, then sift."""

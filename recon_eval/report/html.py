@@ -1,5 +1,7 @@
 """The HTML report: one self-contained file (no external resources), figures embedded as base64
-PNG ``data:`` URIs, every scalar result field in a table, inputs (provenance) listed.
+PNG ``data:`` URIs. It opens with a summary (:mod:`recon_eval.report.summary`: pass / fail
+coloured), then every scalar result field in a table, the inputs (provenance), the figures. All
+text is HTML-escaped.
 
 Written atomically, like the JSON report. The figures come from :mod:`recon_eval.report.plots`
 (matplotlib, imported only when a figure is drawn).
@@ -12,6 +14,7 @@ from dataclasses import dataclass
 
 from recon_eval import SCHEMA_VERSION, __version__
 from recon_eval.report.document import scalar_rows, to_jsonable
+from recon_eval.report.summary import summary_rows
 from scenegen.dataset.files import atomic_write_bytes
 
 
@@ -29,23 +32,54 @@ td,th{border:1px solid #ccc;padding:3px 8px;text-align:left}
 th{background:#f0f0f0} td.num{font-family:monospace;text-align:right}
 figure{margin:1.5em 0} figcaption{font-size:13px;color:#555}
 img{max-width:100%;border:1px solid #ddd}
+tr.pass td.status{background:#d6f5d6;color:#0a5d0a} tr.ok td.status{background:#eef7ee;color:#3b6e3b} tr.fail td.status{background:#f9d2d2;color:#8a0b0b}
+tr.fail td{background:#fdf0f0} td.status{font-weight:bold;text-transform:uppercase;font-size:11px}
+p.verdict{font-size:15px;padding:6px 10px;display:inline-block;border-radius:3px}
+p.verdict.pass{background:#d6f5d6} p.verdict.fail{background:#f9d2d2}
 """
 
 
-def render_html(command: str, inputs: dict, results: dict, figures: list[Figure]) -> str:
+def summary_html(doc: dict, outcomes=()) -> str:
+    """The summary section of a result document: a verdict line and one coloured row per item."""
     esc = html.escape
+    rows = summary_rows(doc, outcomes)
+    n_fail = sum(r.status == "fail" for r in rows)
+    n_pass = sum(r.status == "pass" for r in rows)
+    n_ok = sum(r.status == "ok" for r in rows)
+    verdict = "fail" if n_fail else "pass"
+    gates = sum(r.name.startswith("gate ") for r in rows)
+    text = ((f"{n_fail} failed" if n_fail else "nothing failed") + (f", {n_pass} of {gates} gates passed" if gates else "")
+            + f", {n_ok} estimates produced, {len(rows)} items")
+    parts = [f'<h2>Summary</h2><p class="verdict {verdict}">{esc(text)}</p>',
+             "<table><tr><th>status</th><th>item</th><th>value</th><th>note</th></tr>"]
+    for r in rows:
+        parts.append(f'<tr class="{esc(r.status)}"><td class="status">{esc(r.status)}</td><td>{esc(r.name)}</td>'
+                     f'<td class="num">{esc(r.value)}</td><td>{esc(r.note)}</td></tr>')
+    parts.append("</table>")
+    return "".join(parts)
+
+
+def render_html(command: str, inputs: dict, results: dict, figures: list[Figure], *, metrics: dict | None = None,
+                outcomes=()) -> str:
+    """The report of one command's result (``metrics``: a run's headline numbers; ``outcomes``:
+    gate outcomes to show in the summary)."""
+    esc = html.escape
+    doc = {"command": command, "inputs": to_jsonable(inputs), "results": to_jsonable(results),
+           "metrics": to_jsonable(metrics or {})}
+    label = " ".join(str(doc["inputs"].get(k)) for k in ("method", "scene") if doc["inputs"].get(k))
     parts = [
         "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>recon-eval {esc(command)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>recon-eval {esc(command)}</h1>",
+        f"<title>recon-eval {esc(command)}{' ' + esc(label) if label else ''}</title><style>{_CSS}</style></head><body>",
+        f"<h1>recon-eval {esc(command)}{': ' + esc(label) if label else ''}</h1>",
         f"<p>recon_eval {esc(__version__)}, JSON schema {esc(SCHEMA_VERSION)}. Definitions: docs/metrics.md.</p>",
-        "<h2>Inputs</h2><table><tr><th>input</th><th>value</th></tr>",
+        summary_html(doc, outcomes),
     ]
-    for k, v in to_jsonable(inputs).items():
-        parts.append(f"<tr><td>{esc(str(k))}</td><td>{esc(str(v))}</td></tr>")
-    parts.append("</table><h2>Results</h2><table><tr><th>metric</th><th>field</th><th>value</th></tr>")
+    parts.append("<h2>Results</h2><table><tr><th>metric</th><th>field</th><th>value</th></tr>")
     for metric, field, value in scalar_rows(results):
         parts.append(f'<tr><td>{esc(metric)}</td><td>{esc(field)}</td><td class="num">{esc(value)}</td></tr>')
+    parts.append("</table><h2>Inputs</h2><table><tr><th>input</th><th>value</th></tr>")
+    for k, v in doc["inputs"].items():
+        parts.append(f"<tr><td>{esc(str(k))}</td><td>{esc(str(v))}</td></tr>")
     parts.append("</table>")
     if figures:
         parts.append("<h2>Figures</h2>")

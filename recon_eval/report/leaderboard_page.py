@@ -1,9 +1,12 @@
-"""The leaderboard's pages: one row per run (scene, method, its headline metrics), as Markdown and
-as a self-contained HTML table (the JSON is :func:`recon_eval.ci.leaderboard.run_leaderboard`'s)."""
+"""The leaderboard's pages: one row per run (scene, method, its headline metrics) as Markdown (the
+README's tables, verbatim), and the HTML page of :mod:`recon_eval.report.leaderboard_html` (the
+JSON is :func:`recon_eval.ci.leaderboard.run_leaderboard`'s)."""
 from __future__ import annotations
 
 import html
 import re
+
+from recon_eval.report import leaderboard_html
 
 _NAME = re.compile(r"[A-Za-z0-9_.-]+")
 
@@ -43,10 +46,6 @@ def markdown(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def html_page(doc: dict) -> str:
-    body = "".join(f"<tr><td>{html.escape(s)}</td><td>{html.escape(m)}</td><td>{html.escape(ms)}</td></tr>"
-                   for s, m, ms in rows(doc))
-    return ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>recon-eval leaderboard</title>"
-            "<style>td,th{border:1px solid #ccc;padding:4px;font:13px sans-serif}table{border-collapse:collapse}</style>"
-            f"</head><body><h1>recon-eval leaderboard</h1><table><tr><th>scene</th><th>method</th><th>metrics</th></tr>"
-            f"{body}</table></body></html>\n")
+def html_page(doc: dict, outcomes=()) -> str:
+    """The HTML page: :func:`recon_eval.report.leaderboard_html.html_page` (one sortable table per task)."""
+    return leaderboard_html.html_page(doc, outcomes)

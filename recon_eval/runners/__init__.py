@@ -5,13 +5,16 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
-:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks); shared:
+:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
+(a user's own command line, declared in a methods file or with ``run --command``:
+:mod:`.declared`); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
 the production methods; :data:`FAULTS` the deliberately broken ones of :mod:`.faults`, which gates
 must catch, run by name the same way.
 
 :func:`run_method` runs one registered method and writes ``OUT/result.json`` (the run-result
-JSON, ``command: "run"``, docs/ci.md) next to the raw outputs.
+JSON, ``command: "run"``, docs/ci.md) and ``OUT/report.html`` (its summary and every scalar)
+next to the raw outputs.
 """
 from __future__ import annotations
 
@@ -25,6 +28,7 @@ import cv2
 from recon_eval.errors import InputError, NotApplicable
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report.document import document, to_jsonable, write_json_atomic
+from recon_eval.report.html import render_html, write_html_atomic
 from recon_eval.runners.common import RUN_SCHEMA_VERSION, RunOutput, Timer
 
 
@@ -37,6 +41,24 @@ class Method:
     options: tuple = ()  # (key, value) pairs passed to the function
     fault: bool = False  # a deliberately broken estimator (FAULTS)
 
+    @property
+    def task(self) -> str:
+        """What the method estimates (the leaderboard page's table): :data:`TASKS`, else its module."""
+        return TASKS.get((self.module, self.function), TASKS.get((self.module, None), self.module))
+
+
+#: The task of each runner function ((module, function); (module, None): every function of the
+#: module): methods of one task share a leaderboard table, one column per metric.
+TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo disparity",
+         ("twoview", "fundamental"): "fundamental matrix", ("twoview", "essential"): "essential matrix",
+         ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
+         ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
+         ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
+         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks",
+         ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
+         ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
+         ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
+
 
 def _m(name, module, function, description, **options):
     return Method(name, module, function, description, tuple(sorted(options.items())))
@@ -44,6 +66,9 @@ def _m(name, module, function, description, **options):
 
 _F = ("7point", "8point", "ransac", "lmeds", "usac_default", "usac_parallel", "usac_fm_8pts", "usac_fast",
       "usac_accurate", "usac_prosac", "usac_magsac")
+
+#: The HTML report of a run, beside its result.json.
+REPORT = "report.html"
 
 METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-calib-checkerboard", "calibration", "checkerboard",
@@ -87,29 +112,32 @@ FAULTS: dict[str, Method] = {m.name: m for m in [
 ]}
 
 
-def method(name: str) -> Method:
-    """The registered method ``name``: a production method, else a fault; InputError otherwise."""
-    if name in METHODS:
-        return METHODS[name]
-    if name in FAULTS:
-        return FAULTS[name]
-    close = get_close_matches(name, list(METHODS) + list(FAULTS), n=1)
+def method(name: str, declared: dict | None = None) -> Method:
+    """The registered method ``name``: a production method, else a fault, else one of the user's
+    ``declared`` methods (:mod:`.declared`: external commands); InputError otherwise."""
+    declared = declared or {}
+    for table in (METHODS, FAULTS, declared):
+        if name in table:
+            return table[name]
+    close = get_close_matches(name, list(METHODS) + list(FAULTS) + list(declared), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}; faults: {', '.join(FAULTS)}")
+    mine = f"; declared: {', '.join(declared)}" if declared else ""
+    raise InputError(f"unknown method {name!r}{hint}; known: {', '.join(METHODS)}; faults: {', '.join(FAULTS)}"
+                     f"{mine}")
 
 
-def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
-    """Run method ``name`` on the dataset folder ``dataset``; raw outputs and ``result.json`` go to
-    ``out_dir``. Returns the result document. Raises InputError (NotApplicable when the dataset
-    lacks what the method needs)."""
-    m = method(name)
+def run_method(name: str, dataset, out_dir, *, write: bool = True, declared: dict | None = None) -> dict:
+    """Run method ``name`` (built-in, fault or one of ``declared``) on the dataset folder
+    ``dataset``; raw outputs and ``result.json`` go to ``out_dir``. Returns the result document.
+    Raises InputError (NotApplicable when the dataset lacks what the method needs)."""
+    m = method(name, declared)
     ds = read_dataset(dataset)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     fn = getattr(importlib.import_module(f"recon_eval.runners.{m.module}"), m.function)
     with Timer() as t:
         res: RunOutput = fn(ds, out, dict(m.options))
-    inputs = {"method": m.name, "description": m.description, "options": dict(m.options),
+    inputs = {"method": m.name, "task": m.task, "description": m.description, "options": dict(m.options),
               "dataset": str(dataset), "scene": ds.scene_name, "raw_files": res.raw_files,
               "notes": res.notes, "seconds": t.s, "opencv_version": cv2.__version__,
               "run_schema_version": RUN_SCHEMA_VERSION}
@@ -117,6 +145,7 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True) -> dict:
     doc["metrics"] = to_jsonable(res.metrics)
     if write:
         write_json_atomic(out / "result.json", doc)
+        write_html_atomic(out / REPORT, render_html("run", inputs, res.results, [], metrics=res.metrics))
     return doc
 
 

@@ -113,7 +113,11 @@ def _write_yaml(path, width, height, K, D, model, rms, per_view, views, flags, b
     fs.release()
 
 
-def _score(ds, out: RunOutput, key: str, pre: str, yaml_path, views_used, views_all, rms):
+def score_calibration(ds, out: RunOutput, key: str, pre: str, yaml_path, views_used, views_all, rms) -> None:
+    """Score the calibration file ``yaml_path`` of the camera whose views are ``views_all`` into
+    ``out`` (module docstring; the held-out points of the first of ``views_used``). ``rms``: the
+    calibration's own RMS, None when unknown (an external method): then ``calib_rms_px`` and
+    ``views_used_ratio`` are not reported."""
     est = read_opencv_calibration(yaml_path)  # score what was written
     gt, pose = ds.camera(views_used[0])
     uv, X = ds.points_at_pixels(views_used[0], max_points=HELD_OUT_POINTS)
@@ -131,8 +135,9 @@ def _score(ds, out: RunOutput, key: str, pre: str, yaml_path, views_used, views_
     m[pre + "proj_diff_rms_px"] = pdiff.rms_px
     m[pre + "proj_diff_max_px"] = pdiff.max_px
     m[pre + "held_out_reproj_rms_px"] = rep.rms_px
-    m[pre + "calib_rms_px"] = float(rms)
-    m[pre + "views_used_ratio"] = len(views_used) / len(views_all)
+    if rms is not None:
+        m[pre + "calib_rms_px"] = float(rms)
+        m[pre + "views_used_ratio"] = len(views_used) / len(views_all)
 
 
 def calibrate(ds, out_dir, *, board_kind: str, fisheye: bool,
@@ -181,7 +186,7 @@ def calibrate(ds, out_dir, *, board_kind: str, fisheye: bool,
         _write_yaml(path, *size, K, D, "fisheye" if fisheye else "opencv", rms, per_view, used, flags, board_name)
         out.raw_files.append(path.name)
         out.notes[f"{cam_name}.views_used"] = used
-        _score(ds, out, cam_name, pre, path, used, views, rms)
+        score_calibration(ds, out, cam_name, pre, path, used, views, rms)
     if not out.raw_files and not out.metrics:
         raise NotApplicable(f"{ds.root}: no {'fisheye' if fisheye else 'OpenCV/pinhole'} camera sees the {board_kind} board")
     return out

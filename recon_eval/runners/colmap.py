@@ -13,11 +13,13 @@ Scores (recon_eval.metrics.poses): APE after Sim(3) Umeyama alignment on the cam
 error per camera, translation error in metres), registration ratio (an unregistered view is a
 failure with error inf, never dropped), and the sparse cloud mapped by the same Sim(3) into the
 world frame and scored against the scene meshes (point-to-triangle, Chamfer and the fraction
-within TAU_M).
+within TAU_M). :func:`score_model` scores any COLMAP model so (an external method's too,
+:mod:`recon_eval.runners.external`).
 """
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 
 import numpy as np
 
@@ -26,6 +28,7 @@ from recon_eval.metrics.align import Alignment
 from recon_eval.metrics.pointcloud import chamfer, tanks_and_temples
 from recon_eval.metrics.poses import Poses, ape, registration_ratio
 from recon_eval.readers.colmap_binary import read_colmap_binary
+from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.runners.common import RunOutput, out_path
 
 #: Distance threshold of the sparse-cloud accuracy, metres (Tanks-and-Temples-style precision).
@@ -87,22 +90,33 @@ def incremental(ds, out_dir, options) -> RunOutput:
                       "colmap/sparse/points3D.bin"]
     shutil.rmtree(sparse, ignore_errors=True)
     shutil.rmtree(work, ignore_errors=True)  # the copies of the images
-    est_model = read_colmap_binary(model)  # score what was written
+    return score_model(ds, model, out, n_registered=best.num_reg_images(), n_points=best.num_points3D())
+
+
+def score_model(ds, model_dir, out: RunOutput, *, n_registered: int | None = None,
+                n_points: int | None = None) -> RunOutput:
+    """Score the COLMAP model in ``model_dir`` (binary, else text; image names ``<view>.<ext>``)
+    against the dataset into ``out`` (module docstring). ``n_registered`` / ``n_points``: the
+    mapper's own counts (default: the model's images and points)."""
+    d = Path(model_dir)
+    est_model = read_colmap_binary(d) if (d / "images.bin").is_file() else read_colmap_text(d)  # what was written
     est = est_model.poses
     names = tuple(n.rsplit(".", 1)[0] for n in est.names)
     est = Poses(names, est.R_cam_from_world, est.t_cam_from_world)
     gt = ds.poses
-    if best.num_reg_images() < 3:  # Sim(3) needs 3 centres: a failed run, scored as such, not an input error
+    n_reg = len(names) if n_registered is None else n_registered
+    if n_reg < 3:  # Sim(3) needs 3 centres: a failed run, scored as such, not an input error
         out.metrics.update({"registration_ratio": registration_ratio(est, gt), "max_rot_err_deg": float("inf")})
-        out.notes["failed"] = f"largest model registers {best.num_reg_images()} images (< 3 for Sim(3))"
+        out.notes["failed"] = f"largest model registers {n_reg} images (< 3 for Sim(3))"
         return out
     a = ape(est, gt, alignment=Alignment.SIM3)
     out.results["ape_sim3"] = a
     rr = registration_ratio(est, gt)
     rot = np.asarray(a.rot_err_deg, float)
-    out.metrics.update({"registration_ratio": rr, "max_rot_err_deg": float(np.max(rot)),
-                        "median_rot_err_deg": float(np.median(rot)), "n_points3d": int(best.num_points3D())})
     pts = np.asarray(est_model.points_world, float).reshape(-1, 3)
+    out.metrics.update({"registration_ratio": rr, "max_rot_err_deg": float(np.max(rot)),
+                        "median_rot_err_deg": float(np.median(rot)),
+                        "n_points3d": int(len(pts) if n_points is None else n_points)})
     if len(pts):
         pw = a.tgt_from_src.apply(pts)
         V, F = ds.mesh()

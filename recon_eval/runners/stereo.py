@@ -22,7 +22,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from recon_eval.errors import NotApplicable
+from recon_eval.errors import InputError, NotApplicable
 from recon_eval.metrics.stereo import two_view_metrics
 from recon_eval.readers.pfm import read_pfm
 from recon_eval.runners.common import RunOutput, out_path
@@ -47,30 +47,45 @@ def _matcher(kind: str, width: int, channels: int):
                                  speckleWindowSize=100, speckleRange=2, mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY), nd
 
 
-def run(ds, out_dir, options) -> RunOutput:
-    lefts = ds.stereo_left_views()
-    if not lefts:
-        raise NotApplicable(f"{ds.root}: no rectified stereo pairs (crossview/index.json: stereo)")
-    kind = options["matcher"]
-    out = RunOutput()
-    ests, gts, masks, signed = [], [], [], []
-    for left in lefts:
+def _opencv(kind: str):
+    """``compute(ds, left, path, out)``: the OpenCV matcher ``kind`` on the frame of ``left``, its
+    disparity written as PFM to ``path``."""
+    def compute(ds, left, path, out) -> None:
         L, R = (to_grey8(im) for im in ds.stereo_images(left))
         m, nd = _matcher(kind, L.shape[1], 1 if L.ndim == 2 else L.shape[2])  # grey: 1 channel
         raw = m.compute(L, R).astype(np.float64) / 16.0  # fixed point, 4 fractional bits
-        est = np.where(raw >= 0, raw, np.nan)  # invalid = minDisparity - 1 (/16) -> missing
+        write_pfm(path, np.where(raw >= 0, raw, np.nan))  # invalid = minDisparity - 1 (/16) -> missing
+        out.notes[f"{left}.num_disparities"] = nd
+    return compute
+
+
+def run(ds, out_dir, options, *, compute=None) -> RunOutput:
+    """OpenCV's matcher ``options["matcher"]`` on every rectified frame, scored (module docstring).
+    ``compute(ds, left, path, out)`` replaces it (an external estimator writing the PFM at ``path``,
+    :mod:`recon_eval.runners.external`); a missing or unreadable PFM is scored as no disparity."""
+    lefts = ds.stereo_left_views()
+    if not lefts:
+        raise NotApplicable(f"{ds.root}: no rectified stereo pairs (crossview/index.json: stereo)")
+    compute = compute or _opencv(options["matcher"])
+    out = RunOutput()
+    ests, gts, masks, signed = [], [], [], []
+    for left in lefts:
         path = out_path(out_dir, f"disparity/{left}.pfm")
-        write_pfm(path, est)
-        out.raw_files.append(f"disparity/{left}.pfm")
-        est = read_pfm(path)  # score what was written
+        compute(ds, left, path, out)
         gt = ds.stereo_disparity(left)
+        if path.is_file():
+            out.raw_files.append(f"disparity/{left}.pfm")
+            est = read_pfm(path)  # score what was written
+        else:
+            est = np.full_like(gt, np.nan)
+        if est.shape != gt.shape:
+            raise InputError(f"{path}: disparity shape {est.shape} differs from the truth's {gt.shape}")
         noc = ds.stereo_noc_mask(left)
         ests.append(est)
         gts.append(gt)
         masks.append(noc)
         ok = noc & np.isfinite(gt) & np.isfinite(est)
         signed.append((est - gt)[ok])
-        out.notes[f"{left}.num_disparities"] = nd
     # pooled over frames (Middlebury counts per pixel)
     noc_res = two_view_metrics(ests, gts, masks, benchmark="middlebury_v3")
     all_res = two_view_metrics(ests, gts, [np.isfinite(g) for g in gts], benchmark="middlebury_v3")

@@ -400,3 +400,16 @@ def make_texture(kind: str, params: dict | None = None, seed: int = 0) -> np.nda
         return builder(**params)
     except TypeError as e:  # e.g. a required parameter is missing
         raise ValueError(f"texture kind {kind!r}: {e}") from None
+
+
+def load_data_image(path: Path) -> np.ndarray:
+    """An 8- or 16-bit image read as data (no sRGB decoding): (H, W, 3) float32 in [0, 1]."""
+    img = cv2.imdecode(np.frombuffer(Path(path).read_bytes(), np.uint8), cv2.IMREAD_UNCHANGED)
+    if img is None or img.dtype not in (np.uint8, np.uint16):
+        raise ValueError(f"texture image {str(path)!r}: OpenCV could not decode it as 8/16-bit")
+    a = img.astype(np.float64) / (255.0 if img.dtype == np.uint8 else 65535.0)
+    if a.ndim == 2 or a.shape[2] < 3:  # grey (with or without alpha)
+        a = np.repeat((a if a.ndim == 2 else a[..., 0])[..., None], 3, axis=2)
+    else:
+        a = a[..., :3][..., ::-1]  # OpenCV's BGR -> RGB
+    return np.ascontiguousarray(a, dtype=np.float32)

@@ -141,3 +141,18 @@ def range_from_depth_z(depth_z, rays_z1):
 def depth_z_from_range(range_m, rays_z1):
     """z-depth from range along z = 1 rays (..., 3) (x, y, 1)."""
     return np.asarray(range_m) / np.linalg.norm(np.asarray(rays_z1), axis=-1)
+
+
+def envmap_direction(u, v, rotation_z_deg: float = 0.0) -> np.ndarray:
+    """World direction (..., 3) seen at position (u, v) of an equirectangular environment map
+    (u in [0, 1] left to right along the columns, v in [0, 1] top to bottom along the rows; a
+    texel's centre is at ((col + 0.5) / W, (row + 0.5) / H)).
+
+    Top row (v = 0) is world +z, bottom row -z. The image's centre (u = 0.5) looks along world
+    -y, u = 0.25 along +x, u = 0.75 along -x, u = 0 and 1 along +y: the azimuth
+    atan2(y, x) = 90 deg - 360 deg * u, clockwise seen from above. ``rotation_z_deg`` turns the
+    map counter-clockwise about +z (the direction of u moves to azimuth + rotation_z_deg)."""
+    u, v = np.broadcast_arrays(np.asarray(u, np.float64), np.asarray(v, np.float64))
+    phi = np.radians(90.0 - 360.0 * u + rotation_z_deg)
+    theta = np.pi * v
+    return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)

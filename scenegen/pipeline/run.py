@@ -4,6 +4,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,6 +79,8 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     """
     source = spec_path if isinstance(spec_path, SpecSource) else None
     spec = source.load() if source is not None else load_spec(spec_path)
+    for w in spec.warnings:  # e.g. a spec material replacing a mesh file's own materials
+        print(f"warning: {w}", file=sys.stderr)
     views = resolve_views(spec)
     n_frames = 1 + max((v.frame_index for v in views), default=-1)
     wanted = parse_frames(frames, n_frames)
@@ -89,6 +92,13 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
 
     t0 = time.perf_counter()
     built = load_scene(spec, variant=variant or rs.variant, spp=spp)
+    for name, cam in built.cameras.items():
+        if cam.mask_beyond_fold:
+            n = int(cam.no_ray_mask().sum())
+            print(f"camera {name!r}: {n} of {cam.width * cam.height} pixels "
+                  f"({100 * n / (cam.width * cam.height):.2f} %) lie beyond the distortion's fold "
+                  "radius (mask_beyond_fold): no ray, black, invalid in every truth map",
+                  file=sys.stderr)
     used = RenderSettingsUsed(spp=spp, spp_effective=effective_spp(rs.sampler, spp), seed=seed,
                               variant=built.variant, sampler=rs.sampler, max_depth=rs.max_depth,
                               bit_depth=rs.bit_depth)

@@ -13,10 +13,12 @@ import numpy as np
 import trimesh
 
 from scenegen.assets import meshes, shapes
+from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.arrays import to_jit
-from scenegen.render.materials import board_material, material_dict
+from scenegen.render.asset_materials import asset_bsdf, asset_emitter
+from scenegen.render.materials import board_material, is_alpha_masked, material_dict
 
 
 @dataclass
@@ -31,11 +33,15 @@ class Moving:
     normals: np.ndarray | None = None  # (V, 3) vertex normals, or None (flat shading)
 
 
-def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool):
-    """A Mitsuba mesh from world-frame triangles (float32 on upload), with UVs when present."""
+def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool, emitter: dict | None = None,
+                 vertex_colors: np.ndarray | None = None):
+    """A Mitsuba mesh from world-frame triangles (float32 on upload), with UVs when present, an
+    optional area emitter and optional (V, 3) linear vertex colours (attribute ``vertex_color``)."""
     uv = getattr(mesh.visual, "uv", None)
     props = mi.Properties()
     props["bsdf"] = mi.load_dict(bsdf)
+    if emitter is not None:
+        props["emitter"] = mi.load_dict(emitter)
     mm = mi.Mesh(name, len(mesh.vertices), len(mesh.faces), props=props,
                  has_vertex_normals=smooth, has_vertex_texcoords=uv is not None)
     params = mi.traverse(mm)
@@ -48,6 +54,8 @@ def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool):
         put("vertex_normals", mesh.vertex_normals, np.float32)
     if uv is not None:
         put("vertex_texcoords", uv, np.float32)
+    if vertex_colors is not None:
+        mm.add_attribute("vertex_color", 3, to_jit(mi.Float, np.ravel(vertex_colors), np.float32))
     params.update()
     return mm
 
@@ -68,6 +76,7 @@ def _sphere_entry(obj, bsdf: dict, built) -> dict:
 def object_entry(obj, built) -> dict:
     """The Mitsuba dict entry (or shape) for one spec object; records its world mesh and board."""
     bsdf = material_dict(obj.material)
+    built.alpha_masked |= is_alpha_masked(bsdf)
     if obj.geometry.kind == "sphere":
         return _sphere_entry(obj, bsdf, built)
     local, board = meshes.object_mesh(obj.geometry)
@@ -79,6 +88,46 @@ def object_entry(obj, built) -> dict:
         built.boards[obj.name] = (board, obj.transform.world_from_object @ board.object_from_board())
         bsdf = board_material(board)
     return mitsuba_mesh(obj.name, world, bsdf, meshes.is_smooth(obj.geometry, local, world))
+
+
+def object_entries(obj, key: str, built) -> dict:
+    """The scene-dict entries of one spec object: ``{key: entry}``, or for a mesh rendered with
+    its own materials one Mitsuba mesh per part, ``{key_partNNN: mesh}`` (all parts carry the
+    object's ids). Records the world mesh, boards and whether any entry has an alpha mask."""
+    if obj.geometry.kind == "mesh" and obj.geometry.own_materials:
+        out = _own_material_parts(obj, key, built)
+    else:
+        out = {key: object_entry(obj, built)}
+    return out
+
+
+def _own_material_parts(obj, key: str, built) -> dict:
+    local, _ = meshes.object_mesh(obj.geometry)
+    world = meshes.place(local, obj.transform)
+    built.meshes_world[obj.name] = world
+    smooth = meshes.is_smooth(obj.geometry, local, world)
+    parts = mesh_parts(obj.geometry.path)
+    if sum(p.vertex_count for p in parts) != len(world.vertices) or \
+            sum(p.face_count for p in parts) != len(world.faces):
+        raise ValueError(f"object {obj.name!r}: the parts of {obj.geometry.path_as_written!r} do not "
+                         "add up to the loaded mesh")
+    normals = np.asarray(world.vertex_normals) if smooth else None
+    out = {}
+    for i, p in enumerate(parts):
+        vs, fs = slice(p.vertex_start, p.vertex_start + p.vertex_count), slice(p.face_start, p.face_start + p.face_count)
+        sub = trimesh.Trimesh(vertices=world.vertices[vs], faces=world.faces[fs] - p.vertex_start, process=False)
+        if normals is not None:
+            sub.vertex_normals = normals[vs]
+        if p.uv is not None:
+            sub.visual = trimesh.visual.TextureVisuals(uv=p.uv)
+        am = p.material
+        bsdf = material_dict(obj.material) if am is None else asset_bsdf(am)
+        emitter = None if am is None else asset_emitter(am)
+        colors = None if am is None else am.vertex_colors
+        built.alpha_masked |= is_alpha_masked(bsdf)
+        built.part_meshes[f"{key}_part{i:03d}"] = sub
+        out[f"{key}_part{i:03d}"] = mitsuba_mesh(f"{obj.name}/part{i:03d}", sub, bsdf, smooth, emitter, colors)
+    return out
 
 
 def moving_entry(key: str, obj, entry, mesh_world) -> Moving:

@@ -16,7 +16,7 @@ from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast, sensor as sensor_mod
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
-from scenegen.render.objects import moving_entry, object_entry
+from scenegen.render.objects import moving_entry, object_entries
 from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 from scenegen.spec.assets_check import located
@@ -39,6 +39,9 @@ class LoadedScene:
     emitters: list = field(default_factory=list)  # per spec light, spec order: (Mitsuba key of
     # its power, loaded value = spec power, key of its sampling weight, loaded weight)
     light_scales: tuple = ()  # factor on each spec light's power now in the loaded scene
+    part_meshes: dict = field(default_factory=dict)  # scene-dict key -> world trimesh of one part
+    # of a mesh rendered with its own materials
+    alpha_masked: bool = False  # some surface has an alpha mask: truth rays test its opacity
 
     @property
     def variant(self) -> str:
@@ -60,15 +63,16 @@ class LoadedScene:
 
     def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False) -> dict[str, np.ndarray]:
         """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
-        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored)
+        return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored,
+                          alpha_masked=self.alpha_masked)
 
     def visible_from(self, center_world, points_world) -> np.ndarray:
         """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""
-        return raycast.visible_from(self.scene, center_world, points_world)
+        return raycast.visible_from(self.scene, center_world, points_world, alpha_masked=self.alpha_masked)
 
     def surface_points(self, camera, cam_from_world: Rigid3, uv) -> np.ndarray:
         """(N, 3) world points seen through sub-pixel positions (:func:`scenegen.render.raycast.surface_points`)."""
-        return raycast.surface_points(self.scene, camera, cam_from_world, uv)
+        return raycast.surface_points(self.scene, camera, cam_from_world, uv, self.alpha_masked)
 
 
 def object_key(obj) -> str:
@@ -83,13 +87,14 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     d: dict = {"type": "scene", "integrator": {"type": "path", "max_depth": int(max_depth)}}
     object_ids, instance_ids = {}, {}
     for obj in spec.objects:
-        key = object_key(obj)
         with located(obj, f"object {obj.name!r}"):  # asset errors name the spec's file:line
-            d[key] = object_entry(obj, built)
-        if obj.motion is not None and not obj.motion.is_static:
-            built.moving.append(moving_entry(key, obj, d[key], built.meshes_world[obj.name]))
-        object_ids[key] = obj.object_id
-        instance_ids[key] = obj.instance_id
+            entries = object_entries(obj, object_key(obj), built)
+        d.update(entries)
+        for key, entry in entries.items():
+            if obj.motion is not None and not obj.motion.is_static:
+                built.moving.append(moving_entry(key, obj, entry, built.part_meshes.get(key, built.meshes_world[obj.name])))
+            object_ids[key] = obj.object_id
+            instance_ids[key] = obj.instance_id
         built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
                               "kind": type(obj.geometry).__name__.lower()})
     for i, light in enumerate(spec.lights):

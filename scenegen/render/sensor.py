@@ -43,6 +43,7 @@ class ScenegenSensor(mi.Sensor):
         self.height = 1
         self.lens = None  # (aperture radius m, focus distance m), opaque
         self.time_model = None  # see set_camera
+        self.fold_mask = False
 
     def set_camera(self, camera: Camera, cam_from_world: Rigid3, optics=None, motion=None,
                    time_window=(0.0, 1.0)) -> None:
@@ -60,6 +61,9 @@ class ScenegenSensor(mi.Sensor):
         p = camera.params()
         fields = ("fx", "fy", "cx", "cy", "skew") + ALL_COEFFS
         self.p = SimpleNamespace(**{k: opaque(getattr(p, k)) for k in fields})
+        self.fold_mask = camera.mask_beyond_fold  # pixels beyond the fold: no ray (weight 0)
+        if self.fold_mask:
+            self.p.mask_beyond_fold, self.p.limit = True, opaque(p.limit)
         self.model = camera.model
         self.iterations = camera.undistort_iterations
         self.height = camera.height
@@ -122,6 +126,11 @@ class ScenegenSensor(mi.Sensor):
         rot = lambda x: mi.Vector3f(R[0][0] * x.x + R[0][1] * x.y + R[0][2] * x.z,
                                     R[1][0] * x.x + R[1][1] * x.y + R[1][2] * x.z,
                                     R[2][0] * x.x + R[2][1] * x.y + R[2][2] * x.z)
+        if self.fold_mask:  # no ray beyond the fold radius: a harmless direction, weight 0
+            ok = dr.isfinite(d.x) & dr.isfinite(d.y) & dr.isfinite(d.z)
+            d = dr.select(ok, d, mi.Vector3f(0.0, 0.0, 1.0))
+            o = dr.select(ok, o, mi.Vector3f(0.0))
+            wav_weight = dr.select(ok, wav_weight, 0.0)
         origin = mi.Point3f(rot(o) + mi.Vector3f(*C))
         return mi.Ray3f(origin, rot(d), time, wavelengths), wav_weight
 

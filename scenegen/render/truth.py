@@ -33,6 +33,7 @@ from scenegen.assets.cache import cached_arrays
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.pose import Rigid3
+from scenegen.render.alpha import opaque_intersect
 from scenegen.render.arrays import to_jit
 
 
@@ -87,18 +88,24 @@ def _matvec(R, v):
 
 
 def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
-               row_poses: list[Rigid3] | None = None, as_stored: bool = False) -> dict[str, np.ndarray]:
+               row_poses: list[Rigid3] | None = None, as_stored: bool = False,
+               alpha_masked: bool = False) -> dict[str, np.ndarray]:
     """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring.
 
     ``row_poses`` (rolling shutter): one ``cam_from_world`` per image row; each row's rays start
     from its own pose and ``points_cam``, ``normals_cam``, ``depth_z`` are in that row's camera
     frame. Without it every row uses ``cam_from_world``. ``as_stored``: range and depth_z in
     float32 (the float64 values rounded to nearest, bit for bit what storing them gives).
+    ``alpha_masked``: the scene has alpha masks; rays pass through their holes
+    (:mod:`scenegen.render.alpha`).
     """
     if mi.variant().startswith("scalar"):
+        if alpha_masked:
+            raise ValueError("alpha masks need a vectorised Mitsuba variant for their truth (llvm_ad_rgb / cuda_ad_rgb)")
         if row_poses is not None:
             raise NotImplementedError("rolling-shutter truth needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
         out = _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
+        mark_no_ray(out, camera.no_ray_mask())
         if as_stored:
             out.update({k: out[k].astype(np.float32) for k in ("range", "depth_z")})
         return out
@@ -123,11 +130,15 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     d_world = _matvec(Rwc, d_cam)
     ray = mi.Ray3f(mi.Point3f(mi.Vector3f(C)), mi.Vector3f(d_world))
     # only what the outputs need: position, uv and the shading normal (no dP/dUV derivatives)
-    si = scene.ray_intersect(ray, ray_flags=_flags(), coherent=True)
+    if alpha_masked:
+        si, t_hit = opaque_intersect(scene, ray, _flags(), coherent=True)
+    else:
+        si = scene.ray_intersect(ray, ray_flags=_flags(), coherent=True)
+        t_hit = si.t
     hit = si.is_valid()
     nan64 = dr.nan if hasattr(dr, "nan") else math.nan
-    t = dr.select(hit, mi.Float64(si.t), dr.inf)
-    t_pts = dr.select(hit, mi.Float64(si.t), nan64)  # NaN points for misses
+    t = dr.select(hit, mi.Float64(t_hit), dr.inf)
+    t_pts = dr.select(hit, mi.Float64(t_hit), nan64)  # NaN points for misses
     points_cam = d_cam * t_pts
     points_world = C + d_world * t_pts
     n_world = mi.Vector3d(si.sh_frame.n)
@@ -152,7 +163,28 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     # .numpy() of an evaluated flat array is a zero-copy view: (C, H, W) seen as (H, W, C)
     out = {k: np.moveaxis(b.numpy().reshape(len(vectors[k]), H, W), 0, -1) for k, b in planar.items()}
     out.update({k: v.numpy().reshape(H, W) for k, v in scalars.items()})
+    if camera.mask_beyond_fold:
+        mark_no_ray(out, camera.no_ray_mask())
     return out
+
+
+def mark_no_ray(out: dict, no_ray: np.ndarray) -> None:
+    """Pixels without a ray (beyond a distortion's fold radius): invalid in every truth map, as
+    the dataset stores a miss (valid False, range and depth_z +inf, vectors NaN, ids 0);
+    :meth:`scenegen.geometry.camera.Camera.no_ray_mask` tells them from misses."""
+    if not no_ray.any():
+        return
+    for k, v in list(out.items()):
+        if not v.flags.writeable:
+            out[k] = v = v.copy()
+        if k in ("object_id", "instance_id"):
+            v[no_ray] = 0
+        elif k == "valid":
+            v[no_ray] = False
+        elif k in ("range", "depth_z"):
+            v[no_ray] = np.inf
+        else:
+            v[no_ray] = np.nan
 
 
 def _planar(vector, n: int):

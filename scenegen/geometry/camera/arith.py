@@ -147,8 +147,22 @@ def unproject_pinhole(xd, yd, p, iterations: int, ops):
     return unit_ray_from_z1(xd, yd, ops)
 
 
+#: A camera that masks the pixels beyond its fold: the undistorted point must reproduce the
+#: pixel to this (normalised units, 1e-6 x f px: ten times float32's rounding, so the Dr.Jit
+#: sensor agrees with the float64 truth), else the pixel has no ray.
+FOLD_RESIDUAL = 1e-6
+
+
 def unproject_opencv(xd, yd, p, iterations: int, ops):
     x, y = undistort_opencv_xy(xd, yd, p, iterations)
+    if getattr(p, "mask_beyond_fold", False):  # a Python flag: no branch in the kernel otherwise
+        # no ray where the undistorted point lies beyond the fold radius (r^2 > limit) or does not
+        # reproduce the pixel (the pixel lies beyond the image of the fold: no preimage at all)
+        ex, ey = distort_opencv_xy(x, y, p)
+        res2 = (ex - xd) * (ex - xd) + (ey - yd) * (ey - yd)
+        ok = (x * x + y * y <= p.limit) & (res2 <= FOLD_RESIDUAL * FOLD_RESIDUAL)
+        x = ops.select(ok, x, ops.nan_like(x))
+        y = ops.select(ok, y, ops.nan_like(y))
     return unit_ray_from_z1(x, y, ops)
 
 

@@ -6,6 +6,7 @@ Formulas, parameter orders, the validity rules and the undistortion iteration co
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -14,6 +15,7 @@ import numpy as np
 
 from scenegen.geometry.camera import interop
 from scenegen.geometry.camera.models import ALL_COEFFS, camera_model, project_xyz, unproject_uv
+from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.camera.validity import measure_undistortion, pixel_grid_border_and_interior
 
 
@@ -35,6 +37,8 @@ class Camera:
     cy: float  # px
     skew: float = 0.0  # px; K[0, 1]
     dist: tuple = ()
+    mask_beyond_fold: bool = False  # opt-in: a distortion that folds inside the image is
+    # accepted; pixels beyond the fold radius get no ray (NaN), see :meth:`no_ray_mask`
     # derived at construction (not part of equality)
     undistort_iterations: int = field(default=0, init=False, compare=False)
     limit: float = field(default=math.inf, init=False, compare=False, repr=False)
@@ -54,6 +58,8 @@ class Camera:
         if self.fx <= 0 or self.fy <= 0:
             raise ValueError(f"focal lengths must be positive (px), got fx={self.fx}, fy={self.fy}")
         object.__setattr__(self, "dist", self._normalised_dist(model, self.dist))
+        if self.mask_beyond_fold and self.model not in ("opencv", "pinhole"):  # pinhole: never folds
+            raise ValueError(f"mask_beyond_fold is for the opencv model's polynomial, not {self.model!r}")
         limit, iterations = self._validate_and_measure(model)
         object.__setattr__(self, "limit", limit)
         object.__setattr__(self, "undistort_iterations", iterations)
@@ -117,7 +123,13 @@ class Camera:
         return camera_model(self.model).to_opencv(self)
 
     def with_size(self, width: int, height: int) -> "Camera":
-        return Camera(self.model, width, height, self.fx, self.fy, self.cx, self.cy, self.skew, self.dist)
+        return Camera(self.model, width, height, self.fx, self.fy, self.cx, self.cy, self.skew, self.dist,
+                      self.mask_beyond_fold)
+
+    def no_ray_mask(self) -> np.ndarray:
+        """(H, W) bool: pixel centres beyond the distortion's fold radius, which get no ray (all
+        False unless ``mask_beyond_fold``)."""
+        return _no_ray_mask(self)
 
     def to_dict(self) -> dict:
         """JSON form (cameras.json): model parameters plus K and OpenCV's dist for other readers."""
@@ -128,12 +140,14 @@ class Camera:
             "dist": list(self.dist), "coefficients": self.coefficients(),
             "K": K.tolist(), "opencv_dist": d.tolist(),
             "pixel_convention": "opencv: centre of the top-left pixel is (0, 0)",
+            **({"mask_beyond_fold": True, "pixels_beyond_fold": int(self.no_ray_mask().sum())}
+               if self.mask_beyond_fold else {}),
         }
 
     @classmethod
     def from_dict(cls, d: dict) -> "Camera":
         return cls(d["model"], d["width"], d["height"], d["fx"], d["fy"], d["cx"], d["cy"],
-                   d.get("skew", 0.0), tuple(d.get("dist", ())))
+                   d.get("skew", 0.0), tuple(d.get("dist", ())), bool(d.get("mask_beyond_fold", False)))
 
     # ----- projection
     def project(self, points_cam, return_valid: bool = False):
@@ -181,7 +195,8 @@ class Camera:
         return limit, measure_undistortion(model.undistortion, p, self.width, self.height, self.model)
 
     def _raw_params(self) -> SimpleNamespace:
-        p = dict(fx=self.fx, fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew)
+        p = dict(fx=self.fx, fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew,
+                 mask_beyond_fold=self.mask_beyond_fold)
         p.update({n: 0.0 for n in ALL_COEFFS})
         p.update(self.coefficients())
         return SimpleNamespace(**p)
@@ -211,3 +226,13 @@ class Camera:
     def from_colmap(cls, model_name: str, width: int, height: int, params) -> "Camera":
         """Inverse of :meth:`to_colmap` (also SIMPLE_PINHOLE, SIMPLE_RADIAL, RADIAL)."""
         return cls(*interop.colmap_camera_args(model_name, width, height, params))
+
+
+@functools.lru_cache(maxsize=16)
+def _no_ray_mask(camera: Camera) -> np.ndarray:
+    if not camera.mask_beyond_fold:
+        return np.zeros((camera.height, camera.width), bool)
+    d = camera.unproject_unit(pixel_centers(camera.width, camera.height).reshape(-1, 2))
+    mask = ~np.isfinite(d[:, 0]).reshape(camera.height, camera.width)
+    mask.flags.writeable = False
+    return mask

@@ -53,14 +53,21 @@ def pixel_grid_border_and_interior(width: int, height: int, step: int) -> np.nda
     return np.concatenate([border, np.stack([gu.ravel(), gv.ravel()], 1)])
 
 
+class FoldError(ValueError):
+    """A distortion that folds over inside the image (refused unless the camera opts in to
+    masking the pixels beyond the fold)."""
+
+
 def _reject_if_inside(xd, yd, p, width: int, height: int, what: str, describe: str) -> None:
+    if getattr(p, "mask_beyond_fold", False):
+        return  # opted in: the pixels beyond the fold get no ray (fold_region_polygon)
     xd, yd = np.atleast_1d(xd), np.atleast_1d(yd)
     u = p.fx * xd + p.skew * yd + p.cx
     v = p.fy * yd + p.cy
     inside = in_image(np.stack([u, v], axis=1), width, height)
     if inside.any():
         i = np.argmax(inside)
-        raise ValueError(
+        raise FoldError(
             f"{describe} folds over inside the {width}x{height} image: {what} at pixel ({u[i]:.1f},"
             f" {v[i]:.1f}); the mapping is not monotonic in radius there")
 
@@ -145,14 +152,36 @@ def fisheye_undistortion(xd, yd, p) -> tuple[np.ndarray, int]:
     return ~done | (theta > p.limit), worst
 
 
+def fold_region_polygon(p, n: int = 720) -> tuple[np.ndarray, np.ndarray]:
+    """(xd, yd) (n,) of the image of the valid disk's boundary (r^2 = ``p.limit``) under the
+    OpenCV distortion: the pixels with a ray lie inside this closed curve."""
+    psi = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    r = math.sqrt(p.limit)
+    return distort_opencv_xy(r * np.cos(psi), r * np.sin(psi), p)
+
+
+def inside_polygon(x, y, px, py) -> np.ndarray:
+    """(N,) bool: points (x, y) inside the closed polygon (px, py) (even-odd crossings)."""
+    x, y = np.asarray(x, np.float64)[:, None], np.asarray(y, np.float64)[:, None]
+    x0, y0 = px[None, :], py[None, :]
+    x1, y1 = np.roll(px, -1)[None, :], np.roll(py, -1)[None, :]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cross = ((y0 > y) != (y1 > y)) & (x < (x1 - x0) * (y - y0) / (y1 - y0) + x0)
+    return (np.count_nonzero(cross, axis=1) % 2) == 1
+
+
 def measure_undistortion(measure, p, width: int, height: int, model: str) -> int:
     """The undistortion iteration count of a camera (worst pixel + 1); ValueError naming the first
-    pixel whose ray lies outside the model's valid region. ``p`` carries ``limit``."""
+    pixel whose ray lies outside the model's valid region. ``p`` carries ``limit``. A camera that
+    masks the pixels beyond its fold (``p.mask_beyond_fold``) excludes the pixels outside
+    :func:`fold_region_polygon` (they get no ray); every pixel inside must still converge."""
     grid = pixel_grid_border_and_interior(width, height, max(1, min(width, height) // 64))
     yd = (grid[:, 1] - p.cy) / p.fy
     xd = (grid[:, 0] - p.cx - p.skew * yd) / p.fx
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         bad, worst = measure(xd, yd, p)
+    if getattr(p, "mask_beyond_fold", False) and math.isfinite(p.limit):
+        bad = bad & inside_polygon(xd, yd, *fold_region_polygon(p))
     if bad.any():
         u, v = grid[np.argmax(bad)]
         raise ValueError(

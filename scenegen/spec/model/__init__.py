@@ -26,7 +26,7 @@ Modules, by idea: :mod:`.meta` (field metadata), :mod:`.render`, :mod:`.material
 from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
 from scenegen.spec.model.crossview import CROSSVIEW_PAIR_MODES, CrossviewSpec, MatchSetSpec
 from scenegen.spec.model.geometry import (
-    ARUCO_DICTIONARIES, MESH_SUFFIXES, SHAPE_KINDS, TARGET_KINDS, ArucoGridTarget, Blob, Box,
+    ARUCO_DICTIONARIES, MESH_SUFFIXES, AssetFile, SHAPE_KINDS, TARGET_KINDS, ArucoGridTarget, Blob, Box,
     CharucoTarget, CheckerboardTarget, Cylinder, Mesh, Plane, SceneObject, Shape, Sphere, Target,
     Torus, Transform,
 )
@@ -36,7 +36,8 @@ from scenegen.spec.model.lights import (
 )
 from scenegen.spec.model.materials import (
     CONDUCTOR_NAMES, IMAGE_SUFFIXES, MATERIAL_TYPES, PROCEDURAL_TEXTURE_KINDS, TEXTURE_KINDS,
-    ConductorMaterial, DiffuseMaterial, Material, PlasticMaterial, Texture,
+    ConductorMaterial, DielectricMaterial, DiffuseMaterial, Material, PlasticMaterial,
+    PrincipledMaterial, SurfaceMaps, Texture, ThinDielectricMaterial,
 )
 from scenegen.spec.model.meta import (
     ID_MAX, SEED_MAX, WORLD_UP, FieldInfo, Meta, field_info, frozen_mapping, spec_fields,
@@ -60,8 +61,9 @@ __all__ = [
     "BEAM_WIDTH_FRACTION", "LIGHT_TYPES", "AreaLight", "ConstantLight", "EnvmapLight", "Light",
     "PointLight", "SpotLight",
     "CONDUCTOR_NAMES", "IMAGE_SUFFIXES", "MATERIAL_TYPES", "PROCEDURAL_TEXTURE_KINDS",
-    "TEXTURE_KINDS", "ConductorMaterial", "DiffuseMaterial", "Material", "PlasticMaterial",
-    "Texture",
+    "TEXTURE_KINDS", "ConductorMaterial", "DielectricMaterial", "DiffuseMaterial", "Material",
+    "PlasticMaterial", "PrincipledMaterial", "SurfaceMaps", "Texture", "ThinDielectricMaterial",
+    "AssetFile",
     "ID_MAX", "SEED_MAX", "WORLD_UP", "FieldInfo", "Meta", "field_info", "frozen_mapping",
     "spec_fields",
     "RENDER_VARIANTS", "SAMPLERS", "RenderSettings", "effective_spp",

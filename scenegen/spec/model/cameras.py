@@ -39,6 +39,9 @@ class CameraSpec:
     skew: float = param(0.0, unit=_PX)  # K[0, 1]
     dist: tuple[float, ...] = param((), unit="unitless", derived="zeros, the model's shortest "
                                     "length")  # distortion coefficients, see above
+    mask_beyond_fold: bool = param(False, unit="flag", omit_default=True)  # opt-in for a
+    # distortion that folds over inside the image: pixels beyond the fold radius get no ray and
+    # are invalid in every truth map (otherwise such a camera is refused)
     fov_deg: float | None = param(None, unit="horizontal field of view, degrees", lo=0.0,
                                   lo_open=True, hi=180.0, hi_open=True)  # of the undistorted
     # pinhole as written (fx, fy derived from it: fx = fy = (W/2) / tan(fov/2))
@@ -63,7 +66,8 @@ class CameraSpec:
     def to_camera(self) -> Camera:
         """The :class:`scenegen.geometry.camera.Camera` for these intrinsics."""
         return Camera(model=self.model, width=self.width, height=self.height, fx=self.fx,
-                      fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew, dist=self.dist)
+                      fy=self.fy, cx=self.cx, cy=self.cy, skew=self.skew, dist=self.dist,
+                      mask_beyond_fold=self.mask_beyond_fold)
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)

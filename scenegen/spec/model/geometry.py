@@ -83,9 +83,23 @@ Shape = Union[Plane, Box, Sphere, Cylinder, Torus, Blob]
 
 
 @dataclass(frozen=True, kw_only=True)
+class AssetFile:
+    """A file named inside a mesh file (an OBJ's MTL, a texture map, a glTF buffer or image),
+    checked to lie inside the mesh's folder; hashed with the spec."""
+
+    path: Path = part(unit="absolute path")
+    path_as_written: str = part(unit="the name as written in the asset file (relative to the "
+                                     "mesh's folder)")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Mesh:
     path: Path = part(unit="absolute path of a .ply/.obj/.glb/.gltf/.stl file (trimesh)")
     path_as_written: str = part(unit="the path as in the spec (relative to the spec file)")
+    files: tuple[AssetFile, ...] = part((), unit="files the mesh file names (MTL, textures, "
+                                        "buffers)", omit_default=True)
+    own_materials: bool = part(False, unit="flag: the file's own materials are rendered (the "
+                                           "object has no `material:`)", omit_default=True)
     kind: str = field(default="mesh", init=False)
 
 

@@ -10,7 +10,7 @@ from scenegen.spec.model.meta import SEED_MAX, frozen_mapping, param, part, wher
 
 TEXTURE_KINDS = ("image", "checkerboard", "noise", "speckle", "natural")
 PROCEDURAL_TEXTURE_KINDS = TEXTURE_KINDS[1:]
-MATERIAL_TYPES = ("diffuse", "plastic", "conductor")
+MATERIAL_TYPES = ("diffuse", "plastic", "conductor", "dielectric", "thin_dielectric", "principled")
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".exr", ".hdr", ".tif", ".tiff", ".bmp")
 #: Conductor names Mitsuba 3 knows (its ``conductor``/``roughconductor`` ``material`` values).
 CONDUCTOR_NAMES = (
@@ -42,11 +42,32 @@ class Texture:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SurfaceMaps:
+    """Maps any material may carry (the `normal_map`, `bump_map` and `alpha` keys)."""
+
+    normal_map: Texture | None = part(None, unit="tangent-space normal map image (linear RGB, "
+                                      "2c - 1; +x along u, +y along v = down the image)")
+    bump_map: Texture | None = part(None, unit="height map (its first channel, in [0, 1])")
+    bump_scale: float = param(1.0, unit="metres of displacement per unit of the map's value",
+                              lo=0.0, lo_open=True)  # Mitsuba's bumpmap scale
+    alpha: Texture | None = part(None, unit="opacity map (its first channel, in [0, 1])")
+    alpha_cutoff: float = param(0.5, unit="opacity", lo=0.0, hi=1.0, lo_open=True)  # texels at
+    # or above it are surface (opacity 1), below it holes (opacity 0)
+    alpha_blend: bool = param(False, unit="flag")  # true: continuous opacity instead of the
+    # cutoff (truth rays still take texels >= 0.5 as surface)
+    where: Where | None = where_field()
+
+
+_MAPS = dict(unit="normal map, bump map, alpha mask (None: none)", omit_default=True)
+
+
+@dataclass(frozen=True, kw_only=True)
 class DiffuseMaterial:
     name: str | None = part(None, unit=_NAME)
     color: tuple[float, float, float] | None = param(_GREY, unit="linear RGB", lo=0.0, hi=1.0)
     # reflectance; None when `texture` is given
     texture: Texture | None = part(None, unit="reflectance texture (replaces color)")
+    maps: SurfaceMaps | None = part(None, **_MAPS)
     where: Where | None = where_field()
     type: str = field(default="diffuse", init=False)
 
@@ -60,6 +81,7 @@ class PlasticMaterial:
     roughness: float = param(0.1, unit="GGX alpha", lo=0.0)  # 0 = smooth plastic
     ior: float = param(1.49, unit="index of refraction", lo=1.0, lo_open=True)  # interior;
     # the exterior is air (1.000277)
+    maps: SurfaceMaps | None = part(None, **_MAPS)
     where: Where | None = where_field()
     type: str = field(default="plastic", init=False)
 
@@ -70,8 +92,60 @@ class ConductorMaterial:
     material: str = param("Al", unit="Mitsuba conductor name", label="a conductor name",
                           choices=CONDUCTOR_NAMES)  # e.g. 'Al', 'Cu', 'Au'
     roughness: float = param(0.1, unit="GGX alpha", lo=0.0)  # 0 = smooth mirror-like conductor
+    maps: SurfaceMaps | None = part(None, **_MAPS)
     where: Where | None = where_field()
     type: str = field(default="conductor", init=False)
 
 
-Material = Union[DiffuseMaterial, PlasticMaterial, ConductorMaterial]
+@dataclass(frozen=True, kw_only=True)
+class DielectricMaterial:
+    """Glass, water: a smooth (``dielectric``) or rough (``roughdielectric``) interface."""
+
+    name: str | None = part(None, unit=_NAME)
+    ior: float = param(1.5, unit="index of refraction", lo=1.0, lo_open=True)  # interior
+    # (glass 1.5, water 1.333); the exterior is air (1.000277)
+    roughness: float = param(0.0, unit="GGX alpha", lo=0.0)  # 0 = smooth (dielectric); > 0 =
+    # roughdielectric (frosted glass)
+    transmittance: tuple[float, float, float] = param((1.0, 1.0, 1.0), unit="linear RGB", lo=0.0,
+                                                      hi=1.0)  # specular transmittance (tint)
+    maps: SurfaceMaps | None = part(None, **_MAPS)
+    where: Where | None = where_field()
+    type: str = field(default="dielectric", init=False)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ThinDielectricMaterial:
+    """A thin pane (window glass, a film of water): both interfaces in one surface, no offset."""
+
+    name: str | None = part(None, unit=_NAME)
+    ior: float = param(1.5, unit="index of refraction", lo=1.0, lo_open=True)
+    transmittance: tuple[float, float, float] = param((1.0, 1.0, 1.0), unit="linear RGB", lo=0.0,
+                                                      hi=1.0)
+    maps: SurfaceMaps | None = part(None, **_MAPS)
+    where: Where | None = where_field()
+    type: str = field(default="thin_dielectric", init=False)
+
+
+@dataclass(frozen=True, kw_only=True)
+class PrincipledMaterial:
+    """Mitsuba's principled BSDF (Disney 2015); perceptual roughness (GGX alpha = roughness^2)."""
+
+    name: str | None = part(None, unit=_NAME)
+    color: tuple[float, float, float] | None = param(_GREY, unit="linear RGB", lo=0.0, hi=1.0)
+    # base colour; None when `texture` is given
+    texture: Texture | None = part(None, unit="base colour texture (replaces color)")
+    metallic: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)
+    roughness: float = param(0.5, unit="perceptual roughness", lo=0.0, hi=1.0)
+    specular: float = param(0.5, unit="Disney specular (0.5: F0 = 0.04, IOR 1.5)", label="",
+                            lo=0.0, hi=1.0)
+    spec_trans: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)  # specular transmission
+    # (1 = glass-like)
+    clearcoat: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)
+    sheen: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)
+    maps: SurfaceMaps | None = part(None, **_MAPS)
+    where: Where | None = where_field()
+    type: str = field(default="principled", init=False)
+
+
+Material = Union[DiffuseMaterial, PlasticMaterial, ConductorMaterial, DielectricMaterial,
+                 ThinDielectricMaterial, PrincipledMaterial]

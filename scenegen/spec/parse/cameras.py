@@ -6,6 +6,7 @@ import math
 from typing import Mapping
 
 from scenegen.geometry.camera import MODELS, CameraModel
+from scenegen.geometry.camera.validity import FoldError
 from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model.cameras import CameraSpec
 from scenegen.spec.model.limits import MAX_IMAGE_PIXELS
@@ -13,9 +14,10 @@ from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.imaging import parse_imaging
 from scenegen.spec.parse.optics import OPTICS_KEYS, parse_optics
-from scenegen.spec.parse.read import read_enum, read_float
+from scenegen.spec.parse.read import read_bool, read_enum, read_float
 
-KEYS = ("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "imaging") + OPTICS_KEYS
+KEYS = ("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "mask_beyond_fold",
+        "imaging") + OPTICS_KEYS
 
 
 def coefficient_order(cm: CameraModel) -> str:
@@ -66,6 +68,7 @@ def parse_camera(node: Node, name: str, ctx: ParseContext) -> CameraSpec:
     dist = parse_dist(f.get("dist"), model, cm)
     cam = C(name=name, model=model, width=W, height=H, fx=fx, fy=fy, cx=cx, cy=cy, skew=skew,
             dist=dist, fov_deg=fov, where=node.where,
+            mask_beyond_fold=read_bool(f, C, "mask_beyond_fold"),
             imaging=parse_imaging(f.get("imaging"), name, ctx) if "imaging" in f else None,
             optics=parse_optics(f, model))
     if not (-0.5 <= cx <= W - 0.5 and -0.5 <= cy <= H - 0.5):
@@ -93,6 +96,10 @@ def check_camera(cam: CameraSpec, node: Node) -> None:
     over inside the image); its ValueError becomes a SpecError at ``node``."""
     try:
         cam.to_camera()
+    except FoldError as e:
+        raise node.error(f"impossible camera: {e}; to render it anyway with the pixels beyond the "
+                         "fold radius masked (no ray, invalid in every truth map), set "
+                         "`mask_beyond_fold: true` on the camera") from None
     except ValueError as e:
         raise node.error(f"impossible camera: {e}") from None
 

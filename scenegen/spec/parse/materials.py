@@ -1,4 +1,5 @@
-"""``materials:`` and inline materials: diffuse, plastic, conductor; image and procedural
+"""``materials:`` and inline materials: diffuse, plastic, conductor, dielectric, thin dielectric,
+principled, each with optional normal/bump maps and an alpha mask; image and procedural
 textures (parameter names checked against :mod:`scenegen.assets.textures`)."""
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model import materials as mm
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_enum, read_float, seed_or_none
+from scenegen.spec.parse.read import read_bool, read_color, read_enum, read_float, seed_or_none
 
 
 def freeze(value):
@@ -47,28 +48,47 @@ def parse_texture(node: Node, ctx: ParseContext) -> mm.Texture:
     return mm.Texture(kind=kind, params=freeze(params), seed=seed, where=node.where)
 
 
-def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Material:
-    if node.is_null:
-        raise node.error("expected a material (a mapping with 'type'), got nothing (null)")
-    f = node.as_mapping("a material (a mapping with 'type')")
-    if "type" not in f:
-        f.check(required=("type",), optional=f.keys())
-    kind = f.get("type").as_enum(mm.MATERIAL_TYPES, "material type")
-    if kind == "conductor":
-        C = mm.ConductorMaterial
-        f.check(required=("type",), optional=("material", "roughness"))
-        cname = field_info(C, "material").default
-        if "material" in f:
-            cname = f.get("material").as_str(field_info(C, "material").meta.shown)
-            if cname not in mm.CONDUCTOR_NAMES:
-                raise f.get("material").error(
-                    f"unknown conductor {cname!r}{suggest(cname, mm.CONDUCTOR_NAMES)}; "
-                    "Mitsuba knows e.g. 'Al', 'Ag', 'Au', 'Cu', 'Cr', 'W'")
-        return C(name=name, material=cname, roughness=read_float(f, C, "roughness"),
-                 where=node.where)
-    cls = mm.PlasticMaterial if kind == "plastic" else mm.DiffuseMaterial
-    extra = ("roughness", "ior") if kind == "plastic" else ()
-    f.check(required=("type",), optional=("color", "texture") + extra)
+MAP_KEYS = ("normal_map", "bump_map", "bump_scale", "alpha", "alpha_cutoff", "alpha_blend")
+#: The keys of each material type besides `type` and the maps.
+TYPE_KEYS = {
+    "diffuse": ("color", "texture"),
+    "plastic": ("color", "texture", "roughness", "ior"),
+    "conductor": ("material", "roughness"),
+    "dielectric": ("ior", "roughness", "transmittance"),
+    "thin_dielectric": ("ior", "transmittance"),
+    "principled": ("color", "texture", "metallic", "roughness", "specular", "spec_trans",
+                   "clearcoat", "sheen"),
+}
+CLASSES = {"diffuse": mm.DiffuseMaterial, "plastic": mm.PlasticMaterial,
+           "conductor": mm.ConductorMaterial, "dielectric": mm.DielectricMaterial,
+           "thin_dielectric": mm.ThinDielectricMaterial, "principled": mm.PrincipledMaterial}
+
+
+def parse_map(node: Node, ctx: ParseContext) -> mm.Texture:
+    """A map: a texture mapping, or an image path (shorthand for {type: image, path: ...})."""
+    if node.is_mapping:
+        return parse_texture(node, ctx)
+    path, written = node.as_path(mm.IMAGE_SUFFIXES, "image")
+    return mm.Texture(kind="image", path=path, path_as_written=written, where=node.where)
+
+
+def parse_maps(f, node: Node, ctx: ParseContext) -> mm.SurfaceMaps | None:
+    """The normal map, bump map and alpha mask keys of a material (None when it has none)."""
+    if not any(k in f for k in MAP_KEYS):
+        return None
+    S = mm.SurfaceMaps
+    for k in ("bump_scale", "alpha_cutoff", "alpha_blend"):
+        owner = "bump_map" if k == "bump_scale" else "alpha"
+        if k in f and owner not in f:
+            raise f.get(k).error(f"{k!r} goes with {owner!r}, which is missing")
+    get = lambda k: parse_map(f.get(k), ctx) if k in f else None
+    return S(normal_map=get("normal_map"), bump_map=get("bump_map"),
+             bump_scale=read_float(f, S, "bump_scale"), alpha=get("alpha"),
+             alpha_cutoff=read_float(f, S, "alpha_cutoff"),
+             alpha_blend=read_bool(f, S, "alpha_blend"), where=node.where)
+
+
+def _color_or_texture(f, cls, ctx: ParseContext):
     which = f.one_of(("color", "texture"), required=False)
     color = f.get("color").as_color() if which == "color" else None
     if color is not None and max(color) > field_info(cls, "color").meta.hi:
@@ -76,7 +96,42 @@ def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Materi
     texture = parse_texture(f.get("texture"), ctx) if which == "texture" else None
     if which is None:
         color = field_info(cls, "color").default
+    return color, texture
+
+
+def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Material:
+    if node.is_null:
+        raise node.error("expected a material (a mapping with 'type'), got nothing (null)")
+    f = node.as_mapping("a material (a mapping with 'type')")
+    if "type" not in f:
+        f.check(required=("type",), optional=f.keys())
+    kind = f.get("type").as_enum(mm.MATERIAL_TYPES, "material type")
+    f.check(required=("type",), optional=TYPE_KEYS[kind] + MAP_KEYS)
+    cls = CLASSES[kind]
+    common = {"name": name, "maps": parse_maps(f, node, ctx), "where": node.where}
+    if kind == "conductor":
+        cname = field_info(cls, "material").default
+        if "material" in f:
+            cname = f.get("material").as_str(field_info(cls, "material").meta.shown)
+            if cname not in mm.CONDUCTOR_NAMES:
+                raise f.get("material").error(
+                    f"unknown conductor {cname!r}{suggest(cname, mm.CONDUCTOR_NAMES)}; "
+                    "Mitsuba knows e.g. 'Al', 'Ag', 'Au', 'Cu', 'Cr', 'W'")
+        return cls(material=cname, roughness=read_float(f, cls, "roughness"), **common)
+    if kind in ("dielectric", "thin_dielectric"):
+        extra = {"roughness": read_float(f, cls, "roughness")} if kind == "dielectric" else {}
+        trans = field_info(cls, "transmittance").default
+        if "transmittance" in f:
+            trans = read_color(f.get("transmittance"), cls, "transmittance")
+            if max(trans) > 1.0:
+                raise f.get("transmittance").error(f"expected transmittance in [0, 1] (linear "
+                                                   f"RGB), got {trans}")
+        return cls(ior=read_float(f, cls, "ior"), transmittance=trans, **extra, **common)
+    color, texture = _color_or_texture(f, cls, ctx)
     if kind == "diffuse":
-        return cls(name=name, color=color, texture=texture, where=node.where)
-    return cls(name=name, color=color, texture=texture, roughness=read_float(f, cls, "roughness"),
-               ior=read_float(f, cls, "ior"), where=node.where)
+        return cls(color=color, texture=texture, **common)
+    if kind == "plastic":
+        return cls(color=color, texture=texture, roughness=read_float(f, cls, "roughness"),
+                   ior=read_float(f, cls, "ior"), **common)
+    return cls(color=color, texture=texture,
+               **{k: read_float(f, cls, k) for k in TYPE_KEYS["principled"][2:]}, **common)

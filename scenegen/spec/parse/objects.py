@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from typing import Mapping
 
+from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
 from scenegen.assets.board_raster import BoardRasterError, layout_of, texels_per_unit
+from scenegen.errors import SpecError
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
@@ -33,8 +35,7 @@ def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
     if which == "shape":
         geometry = parse_shape(f.get("shape"), ctx)
     elif which == "mesh":
-        path, written = f.get("mesh").as_path(mg.MESH_SUFFIXES, "mesh")
-        geometry = mg.Mesh(path=path, path_as_written=written)
+        geometry = parse_mesh(f.get("mesh"), f.get("material"), ctx)
     else:
         geometry = parse_target(f.get("target"))
     transform = parse_transform(f.get("transform")) if "transform" in f else mg.Transform()
@@ -45,6 +46,26 @@ def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
                           object_id=object_id, instance_id=instance_id,
                           motion=parse_motion(f.get("motion")) if "motion" in f else None,
                           where=node.where)
+
+
+def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
+    """A mesh file, the files it names (each checked: inside the mesh's folder, existing; an
+    error names the asset file and line) and whether its own materials are rendered: yes when
+    the file has materials and the object gives none; a `material:` replaces them, with a
+    warning."""
+    path, written = node.as_path(mg.MESH_SUFFIXES, "mesh")
+    try:
+        scan = scan_mesh_file(path)
+    except AssetFileError as e:
+        raise SpecError(f"{e.message} (the mesh of {node.where})", file=str(e.file),
+                        line=e.line) from None
+    files = tuple(mg.AssetFile(path=r.path, path_as_written=r.written) for r in scan.refs)
+    if scan.has_materials and mat_node is not None:
+        what = ", ".join(scan.materials) or "vertex colours"
+        ctx.warn(mat_node, f"the mesh {written!r} has its own materials ({what}); this "
+                 "`material:` replaces them all (leave it out to render the file's materials)")
+    return mg.Mesh(path=path, path_as_written=written, files=files,
+                   own_materials=scan.has_materials and mat_node is None)
 
 
 def object_material(mat_node: Node | None, node: Node, materials: Mapping[str, Material],

@@ -83,6 +83,10 @@ def parse_object_variation(name: str, vn: Node, ctx: ParseContext) -> mv.ObjectV
     col = (None, None)
     if "color" in of:
         mat = obj.material
+        if getattr(obj.geometry, "own_materials", False):
+            raise of.get("color").error(
+                f"object {name!r} renders its mesh file's own materials; colour variation needs a "
+                "spec `material:` (diffuse or plastic with a colour) on the object")
         if not isinstance(mat, (DiffuseMaterial, PlasticMaterial)) or mat.color is None:
             raise of.get("color").error(
                 f"object {name!r} has a {mat.type} material"

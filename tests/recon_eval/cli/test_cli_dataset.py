@@ -190,7 +190,7 @@ class TestCalibration:
         from recon_eval.readers.opencv_calib import write_opencv_calibration
 
         write_opencv_calibration(tmp_path / "big.yaml", plane_scene.PINHOLE.with_size(80, 60))
-        code, _, err = run(["calibration", tmp_path / "big.yaml", plane_dataset[0]], capsys)
+        code, _, err = run(["calibration", tmp_path / "big.yaml", plane_dataset[0], "--view", "left_000"], capsys)
         assert code == 2 and "big.yaml: image_width/image_height 80x60 differ" in err
         (tmp_path / "x.yaml").write_text("%YAML:1.0\n---\nD: [0, 0, 0, 0]\n")
         code, _, err = run(["calibration", tmp_path / "x.yaml", plane_dataset[0]], capsys)

@@ -68,6 +68,19 @@ CASES = [
     *[(m.ConductorMaterial, k, "materials:\n  a: {type: conductor}\n",
        lambda s, k=k: getattr(s.materials["a"], k), v)
       for k, v in (("material", "Cu"), ("roughness", 0.3))],
+    *[(m.DielectricMaterial, k, "materials:\n  a: {type: dielectric}\n",
+       lambda s, k=k: getattr(s.materials["a"], k), v)
+      for k, v in (("ior", 1.333), ("roughness", 0.2), ("transmittance", (0.9, 0.9, 0.9)))],
+    *[(m.ThinDielectricMaterial, k, "materials:\n  a: {type: thin_dielectric}\n",
+       lambda s, k=k: getattr(s.materials["a"], k), v)
+      for k, v in (("ior", 1.333), ("transmittance", (0.9, 0.9, 0.9)))],
+    *[(m.PrincipledMaterial, k, "materials:\n  a: {type: principled}\n",
+       lambda s, k=k: getattr(s.materials["a"], k), v)
+      for k, v in (("color", (0.25, 0.25, 0.25)), ("metallic", 0.5), ("roughness", 0.2),
+                   ("specular", 0.3), ("spec_trans", 0.4), ("clearcoat", 0.6), ("sheen", 0.7))],
+    *[(m.SurfaceMaps, k, "materials:\n  a: {type: diffuse, alpha: env.png, bump_map: env.png}\n",
+       lambda s, k=k: getattr(s.materials["a"].maps, k), v)
+      for k, v in (("bump_scale", 0.5), ("alpha_cutoff", 0.3), ("alpha_blend", True))],
     *[(cls, k, f"objects:\n  - {{name: o, shape: {{type: {kind}}}}}\n",
        lambda s, k=k: getattr(s.objects[0].geometry, k), v)
       for cls, kind, k, v in (
@@ -95,7 +108,7 @@ CASES = [
        lambda s, k=k: getattr(s.lights[0], k), v)
       for k, v in (("scale", 2.0), ("rotation_z_deg", 45.0))],
     *[(m.CameraSpec, k, CAM, lambda s, k=k: getattr(s.cameras["cam"], k), v)
-      for k, v in (("model", "opencv"), ("skew", 1.0), ("fov_deg", 60.0))],
+      for k, v in (("model", "opencv"), ("skew", 1.0), ("fov_deg", 60.0), ("mask_beyond_fold", True))],
     *[(optics.Shutter, k, CAM.replace("fx: 50", "fx: 50, shutter: {}"),
        lambda s, k=k: getattr(s.cameras["cam"].optics.shutter, k), v)
       for k, v in (("exposure_s", 0.01), ("rolling_readout_s", 0.001))],

@@ -1,0 +1,320 @@
+"""External methods: a user's own estimator, declared as a command line and an output kind, run
+and scored exactly like a built-in method (docs/ci.md, "Your own estimator").
+
+A method is declared in a methods file (YAML, read by :mod:`scenegen.located_yaml`; errors name
+file:line: field)::
+
+    version: 1
+    methods:
+      - name: my-fmatrix                       # [A-Za-z0-9_.-], not a built-in name
+        kind: fmatrix                          # one of KINDS
+        command: "{python} examples/my_fmatrix.py {images} {out}"
+        timeout_s: 120                         # per invocation (default 600)
+        pixels: distorted                      # fmatrix on images: the pixels F is for (default distorted)
+        description: 8-point F on SIFT matches # optional
+
+or on the command line (``recon-eval run --command CMD --kind KIND [--name NAME]``). Either way it
+becomes a :class:`recon_eval.runners.Method` of this module and runs through
+:func:`recon_eval.runners.run_method`: the same result.json, leaderboard row and gates.
+
+The command is split with :func:`shlex.split` and run without a shell (an argument list), in the
+current directory, once per item of the kind (a pair, a stereo frame). Placeholders ``{name}``
+are replaced by paths recon-eval made (absolute; dataset files, or files in the run folder) or by
+view names checked as dataset names; a placeholder standing alone that holds several paths
+(``{images}``) becomes several arguments. The invocation's stdout and stderr are kept in the run
+folder (``<item>/stdout.txt``, ``stderr.txt``); a non-zero exit, a timeout or a missing or
+unreadable output is scored as a failed estimate of that item (never dropped), with the exit
+status and the last lines of stderr in the result's notes.
+"""
+from __future__ import annotations
+
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from recon_eval.errors import InputError, NotApplicable
+from recon_eval.readers.matrix import read_matrix3
+from recon_eval.readers.npy import read_mask
+from recon_eval.readers.pfm import read_pfm
+from recon_eval.runners import calibration as calib, colmap, stereo, twoview
+from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
+from scenegen.dataset.layout import check_view_name
+
+#: Default per-invocation timeout, seconds.
+TIMEOUT_S = 600.0
+#: Lines of stderr kept in the notes of a failed invocation.
+STDERR_LINES = 12
+PLACEHOLDER = re.compile(r"\{([A-Za-z0-9_]*)\}")
+
+
+@dataclass(frozen=True)
+class Kind:
+    """An output kind: what the command is given and must write, and how it is scored."""
+
+    name: str
+    function: str  # the runner function of this module
+    placeholders: tuple  # the names the command may use ({python} and {dataset} always)
+    contract: str  # one line for --help and the docs
+
+
+KINDS: dict[str, Kind] = {k.name: k for k in [
+    Kind("fmatrix", "fmatrix", ("images", "image1", "image2", "view1", "view2", "matches", "inliers", "out"),
+         "per cross-view pair: write F (3x3 text, x2^T F x1 = 0) to {out}. With {images} / {image1} {image2} the "
+         "images are given and F is scored on the truth correspondences; with {matches} (an (N, 4) .npy of a "
+         "labelled match set, undistorted pixels x1 y1 x2 y2) it runs per match set, may write an inlier mask "
+         "(.npy, N) to {inliers}, and is scored as the built-in F methods"),
+    Kind("disparity", "disparity", ("left", "right", "view1", "out"),
+         "per rectified stereo frame: read {left} {right} (PNG), write the left disparity (PFM, px; inf/nan = none) "
+         "to {out}; scored as the built-in stereo methods"),
+    Kind("calibration", "calibration", ("images", "camera", "out"),
+         "per spec camera: {images} is a folder of its views' images (<view>.png), {camera} its name; write its "
+         "calibration (OpenCV YAML/JSON: camera_matrix, distortion_coefficients, image size) to {out}; scored as "
+         "the built-in calibration methods"),
+    Kind("sfm", "sfm", ("images", "out"),
+         "once: {images} is a folder of <view>.png, write a COLMAP model (cameras, images, points3D; .bin or .txt; "
+         "image names <view>.png) into the folder {out}; scored as pycolmap-incremental"),
+]}
+ALWAYS = ("python", "dataset")
+
+
+def check_command(command: str, kind: str, where: str) -> list[str]:
+    """The argument list of ``command`` (shlex), checked: known kind, placeholders of that kind,
+    ``{out}`` used; InputError naming ``where`` otherwise."""
+    if kind not in KINDS:
+        raise InputError(f"{where}: kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+    try:
+        argv = shlex.split(command)
+    except ValueError as exc:
+        raise InputError(f"{where}: command: cannot split {command!r} ({exc})") from None
+    if not argv:
+        raise InputError(f"{where}: command: empty")
+    allowed = set(KINDS[kind].placeholders) | set(ALWAYS)
+    used = {m for tok in argv for m in PLACEHOLDER.findall(tok)}
+    unknown = sorted(used - allowed)
+    if unknown:
+        raise InputError(f"{where}: command: unknown placeholder {{{unknown[0]}}} for kind {kind!r} (known: "
+                         f"{', '.join('{' + n + '}' for n in KINDS[kind].placeholders + ALWAYS)})")
+    if "out" not in used:
+        raise InputError(f"{where}: command: needs {{out}}, where the method writes its output")
+    if kind == "fmatrix" and "matches" in used and used & {"images", "image1", "image2"}:
+        raise InputError(f"{where}: command: use {{matches}} or the images, not both")
+    return argv
+
+
+def substitute(argv: list[str], values: dict) -> list[str]:
+    """``argv`` with each ``{name}`` replaced by ``values[name]`` (a str, or a list of str that
+    must stand alone in its argument and becomes several arguments)."""
+    out = []
+    for tok in argv:
+        whole = PLACEHOLDER.fullmatch(tok)
+        if whole and isinstance(values.get(whole.group(1)), list):
+            out += [str(v) for v in values[whole.group(1)]]
+            continue
+
+        def one(m):
+            v = values[m.group(1)]
+            if isinstance(v, list):
+                raise InputError(f"command: {{{m.group(1)}}} holds several paths and must be an argument of its own")
+            return str(v)
+
+        out.append(PLACEHOLDER.sub(one, tok))
+    return out
+
+
+def invoke(options: dict, values: dict, log_dir: Path, item: str, out) -> str | None:
+    """Run the method's command for one item; None on success, else why it failed (also recorded
+    in ``out.notes[item]`` with the tail of stderr). A command that cannot start is bad input."""
+    argv = substitute(check_command(options["command"], options["kind"], options.get("declared_at", "command")),
+                      {"python": sys.executable, **values})
+    log_dir.mkdir(parents=True, exist_ok=True)
+    timeout = float(options.get("timeout_s", TIMEOUT_S))
+    try:
+        r = subprocess.run(argv, stdin=subprocess.DEVNULL, capture_output=True, timeout=timeout, check=False)
+        stdout, stderr, why = r.stdout, r.stderr, None if r.returncode == 0 else f"exit status {r.returncode}"
+    except subprocess.TimeoutExpired as exc:
+        stdout, stderr, why = exc.stdout or b"", exc.stderr or b"", f"timed out after {timeout:g} s"
+    except OSError as exc:
+        raise InputError(f"method {options.get('name')!r}: cannot run {argv[0]!r}: {exc.strerror or exc}") from None
+    (log_dir / "stdout.txt").write_bytes(stdout)
+    (log_dir / "stderr.txt").write_bytes(stderr)
+    if why is not None:
+        tail = stderr.decode("utf-8", "replace").strip().splitlines()[-STDERR_LINES:]
+        out.notes[item] = {"failed": why, "stderr_tail": tail, "argv": argv}
+        print(f"recon-eval: {options.get('name')}: {item}: {why}" + (f": {tail[-1]}" if tail else ""),
+              file=sys.stderr)
+    return why
+
+
+def _failed_output(out, item: str, why: str) -> None:
+    out.notes.setdefault(item, {})["failed"] = why
+    print(f"recon-eval: {item}: {why}", file=sys.stderr)
+
+
+def _read_f(path: Path, out, item: str):
+    if not path.is_file():
+        _failed_output(out, item, f"wrote no {path.name}")
+        return None
+    try:
+        return read_matrix3(path, key="F")
+    except InputError as exc:
+        _failed_output(out, item, str(exc))
+        return None
+
+
+def fmatrix(ds, out_dir, options) -> RunOutput:
+    """The ``fmatrix`` kind (:data:`KINDS`)."""
+    argv = check_command(options["command"], "fmatrix", options.get("declared_at", "command"))
+    if any("{matches}" in t for t in argv):
+        return _fmatrix_matches(ds, out_dir, options)
+    pixels = options.get("pixels", "distorted")
+    if pixels not in PIXELS:
+        raise InputError(f"{options.get('declared_at', 'method')}: pixels: expected one of {', '.join(PIXELS)}")
+    pairs = crossview_pairs(ds)
+    out = RunOutput()
+    for i, j in pairs:
+        key = f"{check_view_name(i)}__{check_view_name(j)}"
+        if ds.truth_fundamental(i, j)[0] is None:
+            out.notes[key] = twoview.ZERO_BASELINE_NOTE
+            continue
+        fpath = out_path(out_dir, f"{key}/F.txt")
+        fpath.unlink(missing_ok=True)
+        images = [str(ds.image_path(i).resolve()), str(ds.image_path(j).resolve())]
+        values = {"images": images, "image1": images[0], "image2": images[1], "view1": i, "view2": j,
+                  "out": str(fpath.resolve()), "dataset": str(Path(ds.root).resolve())}
+        failed = invoke(options, values, fpath.parent, key, out)
+        F = None if failed else _read_f(fpath, out, key)
+        if F is None:
+            F = np.full((3, 3), np.nan)
+        else:
+            out.raw_files.append(f"{key}/F.txt")
+        truth = pair_truth(ds, i, j, pixels=pixels, max_points=twoview.TRUTH_POINTS)
+        res = score_pair(F, truth, zhang_if_failed=False)
+        for group, r in res.items():
+            out.results[f"{key}.{group}"] = r
+        pre = "" if len(pairs) == 1 else f"{key}."
+        out.metrics.update({pre + "sampson_rms_px": res["fundamental"].sampson_rms_px,
+                            pre + "pose_err_deg": res["pose_via_K"].pose_err_deg})
+        if "zhang_f_distance" in res:
+            out.metrics[pre + "f_distance_px"] = res["zhang_f_distance"].f_distance_px
+        out.notes[f"{key}.truth"] = truth.notes
+    if not out.results:
+        raise NotApplicable(f"{ds.root}: the cross-view pairs are all zero-baseline: no fundamental matrix to estimate")
+    return out
+
+
+def _fmatrix_matches(ds, out_dir, options) -> RunOutput:
+    """The fmatrix kind on the labelled match sets: the built-in F runner with the command as its fit."""
+    def fit(i, j, kind, x1, x2):
+        item = f"{check_view_name(i)}__{check_view_name(j)}/{kind}"
+        d = Path(out_dir) / item
+        d.mkdir(parents=True, exist_ok=True)
+        mpath, fpath, ipath = d / "matches.npy", d / "F.txt", d / "inliers.npy"
+        for p in (fpath, ipath):
+            p.unlink(missing_ok=True)
+        np.save(mpath, np.concatenate([x1, x2], axis=1))
+        values = {"matches": str(mpath.resolve()), "out": str(fpath.resolve()), "inliers": str(ipath.resolve()),
+                  "view1": i, "view2": j, "dataset": str(Path(ds.root).resolve())}
+        if invoke(options, values, d, item, res_holder):
+            return None, None
+        F = _read_f(fpath, res_holder, item)
+        mask = None
+        if F is not None and ipath.is_file():
+            try:
+                mask = read_mask(ipath, len(x1))
+            except InputError as exc:
+                _failed_output(res_holder, item, str(exc))
+                return None, None
+        return F, mask
+
+    res_holder = RunOutput()
+    out = twoview.fundamental(ds, out_dir, {"flag": "external"}, fit=fit)
+    out.notes.update(res_holder.notes)
+    return out
+
+
+def disparity(ds, out_dir, options) -> RunOutput:
+    """The ``disparity`` kind (:data:`KINDS`): the built-in stereo scoring with the command as matcher."""
+    def compute(ds_, left, path, out) -> None:
+        path.unlink(missing_ok=True)
+        values = {"left": str(ds_.stereo_image_path(left, "left").resolve()),
+                  "right": str(ds_.stereo_image_path(left, "right").resolve()), "view1": check_view_name(left),
+                  "out": str(Path(path).resolve()), "dataset": str(Path(ds_.root).resolve())}
+        if invoke(options, values, Path(out_dir) / "logs" / left, left, out) is None:
+            if not path.is_file():
+                _failed_output(out, left, f"wrote no {path.name}")
+                return
+            try:
+                read_pfm(path)
+            except InputError as exc:
+                _failed_output(out, left, str(exc))
+                path.unlink()
+        else:
+            path.unlink(missing_ok=True)
+
+    return stereo.run(ds, out_dir, options, compute=compute)
+
+
+def sfm(ds, out_dir, options) -> RunOutput:
+    """The ``sfm`` kind (:data:`KINDS`): the built-in SfM scoring of the model the command wrote."""
+    if len(ds.views) < 3:
+        raise NotApplicable(f"{ds.root}: SfM needs at least 3 views, the dataset has {len(ds.views)}")
+    images, model = out_path(out_dir, "images/x").parent, Path(out_dir) / "model"
+    shutil.rmtree(images, ignore_errors=True)
+    shutil.rmtree(model, ignore_errors=True)
+    images.mkdir(parents=True)
+    model.mkdir()
+    for v in ds.views:
+        shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+    out = RunOutput()
+    why = invoke(options, {"images": str(images.resolve()), "out": str(model.resolve()),
+                           "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs", "sfm", out)
+    shutil.rmtree(images, ignore_errors=True)  # the copies of the images
+    files = sorted(str(f.relative_to(out_dir)) for f in model.iterdir() if f.is_file())
+    if why is None:
+        try:
+            colmap.score_model(ds, model, out)
+            out.raw_files += files
+            return out
+        except InputError as exc:  # an unreadable model is the method's failure, not bad input
+            _failed_output(out, "sfm", str(exc))
+    out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
+    return out
+
+
+def calibration(ds, out_dir, options) -> RunOutput:
+    """The ``calibration`` kind (:data:`KINDS`): the built-in calibration scoring of each camera's file."""
+    groups: dict = {}
+    for v in ds.views:
+        groups.setdefault(ds.view_info(v).get("camera_name"), []).append(v)
+    out = RunOutput()
+    for cam, views in groups.items():
+        name = check_view_name(str(cam))
+        images, yaml_path = Path(out_dir) / f"images_{name}", out_path(out_dir, f"calibration_{name}.yaml")
+        shutil.rmtree(images, ignore_errors=True)
+        yaml_path.unlink(missing_ok=True)
+        images.mkdir(parents=True)
+        for v in views:
+            shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+        why = invoke(options, {"images": str(images.resolve()), "camera": name, "out": str(yaml_path.resolve()),
+                               "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs" / name, name, out)
+        shutil.rmtree(images, ignore_errors=True)
+        pre = "" if len(groups) == 1 else f"{name}."
+        if why is None and not yaml_path.is_file():
+            _failed_output(out, name, f"wrote no {yaml_path.name}")
+        elif why is None:
+            try:
+                calib.score_calibration(ds, out, name, pre, yaml_path, views, views, None)
+                out.raw_files.append(yaml_path.name)
+                continue
+            except InputError as exc:  # an unreadable file is the method's failure
+                _failed_output(out, name, str(exc))
+        for k in ("fx_rel_err", "fy_rel_err", "cx_abs_err_px", "cy_abs_err_px", "proj_diff_rms_px"):
+            out.metrics[pre + k] = float("inf")  # a failed calibration: every error inf, never dropped
+    return out
