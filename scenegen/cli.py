@@ -11,7 +11,9 @@ standard library, and ``validate`` no more than the spec parser (docs/performanc
 from __future__ import annotations
 
 import argparse
+import gc
 import json
+import shutil
 import sys
 import time
 import traceback
@@ -19,7 +21,7 @@ import warnings
 from pathlib import Path
 
 from scenegen import __version__
-from scenegen.errors import SpecError
+from scenegen.errors import SpecError, os_error_message
 
 EXIT_BAD_INPUT = 2
 #: ``--variant`` choices: scenegen.spec.model.RENDER_VARIANTS (equal, tests/scenegen/test_cli.py)
@@ -48,6 +50,10 @@ def cmd_validate(args) -> int:
 
     spec = load_spec(args.spec)
     views = resolve_views(spec)
+    if any(o.geometry.kind == "mesh" or getattr(getattr(o.material, "texture", None), "kind", "") == "image"
+           for o in spec.objects):  # files render would read: read them as it does (trimesh, cv2 only then)
+        from scenegen.spec.assets_check import check_assets  # the command's implementation, on use
+        check_assets(spec)  # errors at the spec's file:line
     for name, cam in spec.cameras.items():
         cam.to_camera()  # impossible cameras raise here
     if args.verbosity > QUIET:
@@ -72,10 +78,33 @@ def cmd_render(args) -> int:
             summaries = render_many(args.spec, args.output, variants=args.variants,
                                     workers=args.workers, scheduler=args.scheduler, **kw)
         else:
-            summaries = [render_spec(args.spec, args.output, **kw)]
+            fresh = not args.output.exists()
+            try:
+                summaries = [render_spec(args.spec, args.output, **kw)]
+            except BaseException:
+                if fresh:
+                    _discard_unstarted(args.output)
+                raise
     for s in summaries:
         _print_summary(s)
     return 0
+
+
+def _discard_unstarted(out: Path) -> None:
+    """After a failed render into a folder this run created: remove it when no view was completed
+    in it, so the next run starts afresh instead of being told the folder is not empty. A folder
+    with completed views is kept: ``--resume`` finishes it."""
+    from scenegen.dataset.errors import DatasetError  # the command's implementation, on use
+    from scenegen.dataset.journal import load_current_manifest  # the command's implementation, on use
+    from scenegen.dataset.manifest import STATUS_COMPLETE  # the command's implementation, on use
+
+    gc.collect()  # drop the failed writer (and its lock) before looking
+    try:
+        done = [v for v, e in load_current_manifest(out)["views"].items() if e["status"] == STATUS_COMPLETE]
+    except (DatasetError, OSError, ValueError):
+        done = None if any(p.is_file() and not p.name.startswith(".") for p in out.rglob("*")) else []
+    if done == [] and out.is_dir():
+        shutil.rmtree(out, ignore_errors=True)
 
 
 def _print_summary(s) -> None:
@@ -257,6 +286,9 @@ def _bad_input_errors() -> tuple[type, ...]:
 
 
 def main(argv=None) -> int:
+    bad = next((a for a in (sys.argv[1:] if argv is None else argv) if "\x00" in str(a)), None)
+    if bad is not None:  # no path, name or option can hold one
+        return _err(f"the argument {str(bad)!r} contains a NUL byte")
     args = build_parser().parse_args(argv)
     args.verbosity = QUIET if args.quiet else VERBOSE if args.verbose else NORMAL
     t0 = time.perf_counter()
@@ -272,6 +304,8 @@ def main(argv=None) -> int:
             return _err(str(e), args)
         if isinstance(e, BrokenPipeError):  # output piped into e.g. `head`
             return 0
+        if isinstance(e, OSError):  # a full disk, a read-only or forbidden folder: one line, exit 2
+            return _err(os_error_message(e), args)
         raise
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

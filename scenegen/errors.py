@@ -6,6 +6,7 @@ parsed spec (texture generation, mesh loading, rendering) can point back into th
 """
 from __future__ import annotations
 
+import errno
 from dataclasses import dataclass
 
 
@@ -58,3 +59,25 @@ class SpecError(Exception):
 
 def _rebuild(message, file, line, field):
     return SpecError(message, file=file, line=line, field=field)
+
+
+#: What to do about an OSError, by errno name: disk full, read-only, no permission, too many files.
+_OS_ADVICE = {"ENOSPC": "the disk is full: free space or write to another disk, then run again (a render "
+                        "continues with --resume: everything already written is kept)",
+              "EDQUOT": "the disk quota is exceeded: free space, then run again with --resume",
+              "EROFS": "the file system is read-only: write to another folder (-o)",
+              "EACCES": "permission denied: write to a folder you may write to, or fix its permissions",
+              "EPERM": "operation not permitted: write to a folder you may write to",
+              "EISDIR": "it is a directory: give a file name",
+              "ENOTDIR": "a part of the path is a file, not a folder",
+              "ENAMETOOLONG": "the path is too long",
+              "EMFILE": "too many open files: raise the limit (ulimit -n) or use fewer workers"}
+
+
+def os_error_message(e: OSError) -> str:
+    """One line for an OSError: the file it concerns, what happened and what to do."""
+    name = errno.errorcode.get(e.errno or 0, "")
+    where = e.filename if e.filename is not None else "(no file named)"
+    what = e.strerror or str(e)
+    advice = _OS_ADVICE.get(name)
+    return f"{where}: {what}" + (f": {advice}" if advice else "")

@@ -37,6 +37,7 @@ from recon_eval.ci.metric_paths import resolve
 from recon_eval.errors import InputError
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Node
+from scenegen.located_yaml.source import read_source
 
 OPS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge, "==": operator.eq,
        "!=": operator.ne}
@@ -71,10 +72,7 @@ def load_gates(path) -> list[Gate]:
     """Parse and validate a gate file; errors name file:line: field."""
     p = Path(path)
     try:
-        text = p.read_text()
-    except OSError as exc:
-        raise InputError(f"{p}: cannot read ({exc.strerror})") from None
-    try:
+        text = read_source(p, "gate file")  # size limit, UTF-8, one-line errors
         return _gates(Document(text, str(p), p.parent).root)
     except SpecError as exc:  # the located-YAML layer's error, as recon_eval's bad input
         raise InputError(str(exc)) from None
@@ -122,6 +120,8 @@ def load_results(paths) -> list[tuple[str, dict]]:
             raise InputError(f"{p}: cannot read ({exc.strerror})") from None
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise InputError(f"{p}:{getattr(exc, 'lineno', 1)}: invalid JSON: {getattr(exc, 'msg', exc)}") from None
+        except RecursionError:
+            raise InputError(f"{p}: invalid JSON: nested too deeply") from None
         if isinstance(doc, dict) and doc.get("command") == "leaderboard" and isinstance(doc.get("runs"), list):
             out += [(f"{p}#runs[{k}]", r) for k, r in enumerate(doc["runs"]) if isinstance(r, dict)]
         elif (isinstance(doc, dict) and isinstance(doc.get("command"), str) and isinstance(doc.get("results"), dict)

@@ -14,6 +14,7 @@ from recon_eval.report.document import write_json_atomic
 from recon_eval.report.html import render_html, write_html_atomic
 from recon_eval.report.leaderboard_page import html_page, markdown
 from recon_eval.runners import REPORT, method, run_method
+from scenegen.dataset.layout import check_name
 
 
 def run_leaderboard(datasets, methods, out_dir, *, log=print, declared: dict | None = None) -> dict:
@@ -24,6 +25,10 @@ def run_leaderboard(datasets, methods, out_dir, *, log=print, declared: dict | N
     runs, skipped, dirs = [], [], []
     for d in datasets:
         scene = read_dataset(d).scene_name
+        try:
+            check_name("scene", scene)  # it becomes a folder under out_dir: no '/', no '..'
+        except ValueError as exc:
+            raise InputError(f"{d}: the dataset's scene name cannot be a folder name: {exc}") from None
         for m in methods:
             try:
                 doc = run_method(m, d, out / scene / m, declared=declared)

@@ -48,6 +48,7 @@ from recon_eval import __version__
 from recon_eval.cli.common import configure_progress
 from recon_eval.cli.registry import BY_NAME, COMMANDS
 from recon_eval.errors import InputError
+from scenegen.errors import os_error_message
 
 EXIT_BAD_INPUT = 2
 
@@ -57,10 +58,18 @@ def _family(command: str):
     return importlib.import_module(f"recon_eval.cli.{BY_NAME[command].family}")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line usage error (exit 2, as argparse's own) pointing at ``--help``."""
+
+    def error(self, message):
+        print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
+        sys.exit(EXIT_BAD_INPUT)
+
+
 def build_parser(argv=None, *, full: bool = False) -> argparse.ArgumentParser:
     """The ``recon-eval`` parser. Every command is listed; the arguments are added for the command
     named in ``argv`` (its family module is imported), or for every command with ``full``."""
-    ap = argparse.ArgumentParser(prog="recon-eval", description="Score 3D-vision results against exact ground truth.")
+    ap = _Parser(prog="recon-eval", description="Score 3D-vision results against exact ground truth.")
     ap.add_argument("--version", action="version", version=f"recon-eval {__version__}")
     global_options(ap, top=True)
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -108,7 +117,11 @@ def parse_args(argv) -> argparse.Namespace:
 def main(argv=None) -> int:
     """Run one command; its exit code: 0 ok, 1 a gate failed, 2 bad input (no traceback)."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = parse_args(argv)
+    bad = next((a for a in argv if "\x00" in str(a)), None)
+    if bad is not None:  # no path, name or option can hold one
+        print(f"recon-eval: error: the argument {str(bad)!r} contains a NUL byte", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    args = parse_args(argv)  # argparse itself exits with code 2 on bad usage
     configure_progress(enabled=not args.quiet, every_s=0.5 if args.verbose else 2.0)
     t0 = time.perf_counter()
     try:
@@ -124,7 +137,7 @@ def main(argv=None) -> int:
     except OSError as exc:  # unreadable input or unwritable output
         if args.verbose:
             traceback.print_exc()
-        print(f"recon-eval: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
+        print(f"recon-eval: error: {os_error_message(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
 

@@ -18,6 +18,14 @@ def dataset_view(ds, view, where: str) -> str:
     return ds.check_view(view)
 
 
+def image_size(size, flag: str = "--size") -> tuple[int, int]:
+    """(W, H) of a ``--size W H`` option: two positive whole numbers (InputError otherwise)."""
+    w, h = (int(v) for v in size)
+    if w < 1 or h < 1:
+        raise InputError(f"{flag}: expected the image width and height in pixels (two numbers >= 1), got {w} {h}")
+    return w, h
+
+
 def same_shape(est, gt, est_name, gt_name) -> None:
     if est.shape != gt.shape:
         raise InputError(f"{est_name}: shape {est.shape} differs from the truth's {gt.shape} ({gt_name})")

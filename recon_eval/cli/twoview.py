@@ -6,9 +6,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from recon_eval.cli.common import image_size
 from recon_eval.cli.scored import no_figures, scored
 from recon_eval.errors import InputError
-from recon_eval.metrics.epipolar import fundamental_degeneracy, homography_mace, homography_summary, sampson_sq_px2
+from recon_eval.metrics.epipolar import (fundamental_degeneracy, homography_degeneracy, homography_mace,
+                                         homography_summary, sampson_sq_px2)
 from recon_eval.readers.matrix import read_matrix3
 from recon_eval.readers.npy import read_mask, read_npy
 from recon_eval.readers.registry import read_image
@@ -56,6 +58,8 @@ def score_fmatrix(a):
     F = read_matrix3(a.f_est, key="F")
     inputs = {"f_est": a.f_est, "matches": a.matches, "f_gt": a.f_gt, "dataset": a.dataset, "views": a.views}
     labels = images = None
+    if a.size:
+        image_size(a.size)  # two positive numbers (InputError otherwise)
     if a.dataset:
         if not a.views:
             raise InputError("--dataset needs --views VIEW1 VIEW2")
@@ -128,7 +132,11 @@ def homography_arguments(p) -> None:
 
 
 def score_homography(a):
-    r = homography_mace(read_matrix3(a.h_est, key="H"), read_matrix3(a.h_gt, key="H"), *a.size)
+    W, H = image_size(a.size)
+    H_gt = read_matrix3(a.h_gt, key="H")
+    if (why := homography_degeneracy(H_gt)) is not None:
+        raise InputError(f"{a.h_gt}: the truth H is degenerate ({why})")
+    r = homography_mace(read_matrix3(a.h_est, key="H"), H_gt, W, H)
     return ({"h_est": a.h_est, "h_gt": a.h_gt, "size": a.size},
             {"homography": r, "summary": homography_summary([r.mace_px])}, no_figures)
 

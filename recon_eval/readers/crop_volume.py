@@ -19,6 +19,8 @@ def read_crop_volume(path) -> CropVolume:
         doc = json.loads(read_text(p, "a crop volume JSON"))
     except json.JSONDecodeError as exc:
         raise InputError(f"{p}:{exc.lineno}: not JSON ({exc.msg})") from None
+    except RecursionError:
+        raise InputError(f"{p}: not JSON (nested too deeply)") from None
     if not isinstance(doc, dict) or doc.get("class_name", "SelectionPolygonVolume") != "SelectionPolygonVolume":
         raise InputError(f"{p}: class_name: expected SelectionPolygonVolume")
     missing = [k for k in ("bounding_polygon", "orthogonal_axis", "axis_min", "axis_max") if k not in doc]

@@ -2,14 +2,13 @@
 (9 numbers, whitespace or commas, '#' comments)."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.readers.npy import read_npy
-from recon_eval.readers.text import read_text
+from recon_eval.readers.text import json_document, read_text
 
 
 def read_matrix3(path, key: str | None = None) -> np.ndarray:
@@ -20,10 +19,7 @@ def read_matrix3(path, key: str | None = None) -> np.ndarray:
         return read_npy(p, (3, 3))
     text = read_text(p, "a 3x3 matrix as text or JSON")
     if p.suffix.lower() == ".json":
-        try:
-            obj = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"{p}: invalid JSON ({exc})") from None
+        obj = json_document(text, p, "a 3x3 matrix")
         if isinstance(obj, dict):
             if key is None or key not in obj:
                 raise InputError(f"{p}: expected a 3x3 list or an object with key {key!r}")

@@ -28,7 +28,7 @@ import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.metrics.poses import Poses
-from recon_eval.readers.text import read_text
+from recon_eval.readers.text import json_document, read_text
 from scenegen.geometry.camera import Camera, camera_model
 from scenegen.geometry.camera.interop import COLMAP_MODELS
 from scenegen.geometry.conventions import (cam_from_world_from_opengl, colmap_from_opencv_pixels,
@@ -85,10 +85,7 @@ def read_nerf_transforms(path) -> NerfTransforms:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a NeRF transforms.json)")
-    try:
-        doc = json.loads(read_text(p, "a NeRF transforms.json"))
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{p}: invalid JSON ({exc})") from None
+    doc = json_document(read_text(p, "a NeRF transforms.json"), p, "a NeRF transforms.json")
     if not isinstance(doc, dict) or not isinstance(doc.get("frames"), list):
         raise InputError(f"{p}: frames: expected a list of frames with file_path and transform_matrix")
     top = {k: doc[k] for k in _INTRINSIC_KEYS if k in doc}

@@ -23,10 +23,12 @@ import cv2
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers.text import read_text
+from recon_eval.readers.text import bracket_depth, duplicate_key, read_text
 from scenegen.geometry.camera import Camera, camera_model
 
 K_KEYS = ("camera_matrix", "K", "cameraMatrix")
+#: Deepest [ { nesting handed to OpenCV's parser (a calibration file nests 3 deep).
+MAX_NESTING = 64
 D_KEYS = ("distortion_coefficients", "D", "dist_coeffs", "distCoeffs")
 FISHEYE_MODELS = ("equidistant", "fisheye", "kannala_brandt")
 
@@ -68,6 +70,10 @@ def read_opencv_calibration(path, *, model: str | None = None, size: tuple | Non
     if not text.lstrip().startswith(("{", "%YAML")):
         # OpenCV refuses YAML without its directive (ROS camera_info files have none)
         text = "%YAML:1.0\n---\n" + text
+    if (dup := duplicate_key(text)) is not None:  # OpenCV would let the last one win silently
+        raise InputError(f"{p}:{dup[0]}: duplicate key {dup[1]!r} (first given at line {dup[2]})")
+    if bracket_depth(text) > MAX_NESTING:  # OpenCV would recurse until the process crashes
+        raise InputError(f"{p}: not a readable OpenCV YAML/JSON file (nested deeper than {MAX_NESTING} levels)")
     try:
         fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:

@@ -11,14 +11,14 @@ A bare matrix is read in ``convention`` (default ``cam_from_world``, OpenCV ``so
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.readers.npy import read_npy
-from recon_eval.readers.text import read_text
+from recon_eval.readers.text import json_document, read_text
+from scenegen.geometry.rotation import is_rotation
 
 CONVENTIONS = ("cam_from_world", "world_from_cam")
 
@@ -46,10 +46,7 @@ def read_pose(path, convention: str = "cam_from_world") -> tuple[np.ndarray, np.
     if p.suffix.lower() == ".npy":
         R, t = _from_matrix(read_npy(p), p)
     elif p.suffix.lower() == ".json":
-        try:
-            obj = json.loads(read_text(p, "a camera pose as JSON"))
-        except json.JSONDecodeError as exc:
-            raise InputError(f"{p}: invalid JSON ({exc})") from None
+        obj = json_document(read_text(p, "a camera pose as JSON"), p, "a camera pose")
         if isinstance(obj, dict):
             for key in CONVENTIONS:
                 if key in obj:
@@ -76,6 +73,10 @@ def read_pose(path, convention: str = "cam_from_world") -> tuple[np.ndarray, np.
         except ValueError:
             raise InputError(f"{p}: expected 12 or 16 numbers") from None
         R, t = _from_matrix(M, p)
+    if np.all(np.isfinite(R)) and not is_rotation(R):  # NaN: a failed estimate, scored as a failure
+        err = float(np.abs(R @ R.T - np.eye(3)).max())
+        raise InputError(f"{p}: R is not a rotation (|R R^T - I| = {err:.2g}, det {np.linalg.det(R):.6g}; "
+                         "expected orthonormal with det +1)")
     if convention == "world_from_cam":
         R = R.T
         t = -R @ t

@@ -3,7 +3,12 @@ README's tables, verbatim), and the HTML page of :mod:`recon_eval.report.leaderb
 JSON is :func:`recon_eval.ci.leaderboard.run_leaderboard`'s)."""
 from __future__ import annotations
 
+import html
+import re
+
 from recon_eval.report import leaderboard_html
+
+_NAME = re.compile(r"[A-Za-z0-9_.-]+")
 
 
 def _fmt(v) -> str:
@@ -23,9 +28,21 @@ def rows(doc: dict) -> list[tuple[str, str, str]]:
     return out
 
 
+def markdown_text(text: str) -> str:
+    """``text`` as plain Markdown table-cell text: HTML escaped (no raw ``<script>`` from a name
+    or an error message), the cell separator and code marks backslash-escaped, on one line."""
+    text = html.escape(" ".join(str(text).split()), quote=False)
+    return "".join("\\" + c if c in "\\`|" else c for c in text)
+
+
+def markdown_name(name: str) -> str:
+    """A scene or method name as a code span when it is made of name characters, else as text."""
+    return f"`{name}`" if _NAME.fullmatch(str(name)) else markdown_text(name)
+
+
 def markdown(doc: dict) -> str:
     lines = ["| scene | method | metrics |", "|---|---|---|"]
-    lines += [f"| `{s}` | `{m}` | {ms} |" for s, m, ms in rows(doc)]
+    lines += [f"| {markdown_name(s)} | {markdown_name(m)} | {markdown_text(ms)} |" for s, m, ms in rows(doc)]
     return "\n".join(lines) + "\n"
 
 

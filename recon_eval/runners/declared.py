@@ -17,6 +17,7 @@ from recon_eval.errors import InputError
 from recon_eval.runners import FAULTS, METHODS, Method
 from recon_eval.runners.external import KINDS, PIXELS, TIMEOUT_S, check_command
 from scenegen.dataset.layout import NAME_RE
+from scenegen.located_yaml.source import read_source
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Node
 
@@ -46,10 +47,7 @@ def load_methods(path) -> dict[str, Method]:
     """The methods of a methods file, by name."""
     p = Path(path)
     try:
-        text = p.read_text()
-    except OSError as exc:
-        raise InputError(f"{p}: cannot read ({exc.strerror})") from None
-    try:
+        text = read_source(p, "methods file")  # size limit, UTF-8, one-line errors
         root = Document(text, str(p), p.parent).root
         doc = root.as_mapping("a mapping with 'version' and 'methods'").check(required=("version", "methods"))
         version = doc.req("version")

@@ -43,7 +43,7 @@ from recon_eval.metrics.triangulation import (noisy_observations, pool_scores, p
 from recon_eval.readers.rows import read_projection_matrix, read_rows
 from recon_eval.report.document import write_json_atomic
 from scenegen.dataset.files import atomic_write_bytes
-from scenegen.dataset.layout import CROSSVIEW_INDEX
+from scenegen.dataset.layout import CROSSVIEW_INDEX, check_name, check_rel_path
 from scenegen.geometry import seeds
 from scenegen.geometry.pose import camera_center
 from scenegen.geometry.twoview import ZERO_BASELINE_M
@@ -194,6 +194,8 @@ def read_task(task_dir) -> tuple[dict, list]:
         doc = json.loads(jpath.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{jpath}: invalid JSON ({exc})") from None
+    except RecursionError:
+        raise InputError(f"{jpath}: invalid JSON (nested too deeply)") from None
     if not isinstance(doc, dict) or doc.get("format") != TASK_FORMAT:
         raise InputError(f"{jpath}: format: expected {TASK_FORMAT!r}")
     if doc.get("version") != TASK_VERSION:
@@ -202,11 +204,12 @@ def read_task(task_dir) -> tuple[dict, list]:
     for k, e in enumerate(doc.get("pairs") or []):
         where = f"{jpath}: pairs[{k}]"
         try:
-            name, files, n = e["name"], e["files"], int(e["n_points"])
+            name, files, n = check_name("pair", e["name"]), e["files"], int(e["n_points"])
+            files = {f: check_rel_path(files[f]) for f in ("P1", "P2", "observations", "truth")}  # no '..'
             cams = [(np.asarray(e[c]["R"], np.float64), np.asarray(e[c]["t"], np.float64))
                     for c in ("cam1_from_world", "cam2_from_world")]
             paths = {f: root / files[f] for f in ("P1", "P2", "observations", "truth")}
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise InputError(f"{where}: missing or malformed field ({type(exc).__name__}: {exc})") from None
         if any(R.shape != (3, 3) or t.shape != (3,) for R, t in cams):
             raise InputError(f"{where}: cam*_from_world: expected R 3x3 and t 3 numbers")

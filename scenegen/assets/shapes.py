@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from scenegen.assets.checks import count as _count, positive as _positive
+from scenegen.assets.checks import check_mesh_arrays, check_mesh_file, count as _count, positive as _positive
 
 #: File extensions :func:`load_mesh` accepts.
 MESH_EXTENSIONS = (".ply", ".obj", ".glb", ".gltf", ".stl")
@@ -379,8 +379,7 @@ def load_mesh(path) -> trimesh.Trimesh:
     if ext not in MESH_EXTENSIONS:
         raise ValueError(f"mesh file {str(p)!r}: unsupported extension {ext!r}; "
                          f"supported: {', '.join(MESH_EXTENSIONS)}")
-    if not p.is_file():
-        raise ValueError(f"mesh file {str(p)!r}: file not found")
+    check_mesh_file(p)  # a directory, missing, empty or too large: ValueError naming it
     try:
         scene = trimesh.load_scene(str(p), process=False)
         parts = []  # (vertices, faces, uv or None, material or None)
@@ -408,9 +407,11 @@ def load_mesh(path) -> trimesh.Trimesh:
     offsets = np.cumsum([0] + [len(v) for v, *_ in parts])[:-1]
     verts = np.concatenate([v for v, *_ in parts])
     faces = np.concatenate([f + o for (_, f, *_), o in zip(parts, offsets)])
+    check_mesh_arrays(str(p), verts, faces)
     visual = None
     if all(uv is not None for _, _, uv, _ in parts):
         material = parts[0][3] if len(parts) == 1 else None
         visual = trimesh.visual.TextureVisuals(
             uv=np.concatenate([uv for _, _, uv, _ in parts]), material=material)
     return trimesh.Trimesh(vertices=verts, faces=faces, visual=visual, process=False)
+

@@ -21,6 +21,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from scenegen.assets.checks import MAX_TEXTURE_PIXELS
 from scenegen.geometry.color import linear_from_srgb
 
 Color = tuple[float, float, float]
@@ -40,6 +41,9 @@ def _size_wh(size_px) -> tuple[int, int]:
                 from None
     if w < 1 or h < 1:
         raise ValueError(f"size_px must be positive, got {size_px!r}")
+    if w * h > MAX_TEXTURE_PIXELS:
+        raise ValueError(f"size_px {w} x {h} is more than {MAX_TEXTURE_PIXELS:,} pixels (MAX_TEXTURE_PIXELS, "
+                         "docs/scene_spec.md 'Limits')")
     return w, h
 
 
@@ -302,11 +306,18 @@ def load_image(path) -> np.ndarray:
     Raises ValueError naming the file when it is missing or cannot be decoded.
     """
     p = Path(path)
+    if p.is_dir():
+        raise ValueError(f"texture image {str(p)!r}: is a directory, expected a PNG or JPEG file")
     if not p.is_file():
         raise ValueError(f"texture image {str(p)!r}: file not found")
     # imdecode on the bytes avoids cv2.imread's silent None on non-ASCII paths.
     raw = np.frombuffer(p.read_bytes(), dtype=np.uint8)
-    img = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED)
+    if raw.size == 0:
+        raise ValueError(f"texture image {str(p)!r}: the file is empty")
+    try:
+        img = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED)
+    except cv2.error as e:  # e.g. a header announcing more pixels than OpenCV allows
+        raise ValueError(f"texture image {str(p)!r}: OpenCV could not decode it ({str(e).strip().splitlines()[-1]})") from None
     if img is None or img.size == 0:
         raise ValueError(f"texture image {str(p)!r}: OpenCV could not decode it")
     if img.dtype == np.uint8:
@@ -346,6 +357,27 @@ def texture_params(kind: str) -> tuple[str, ...]:
         raise ValueError(f"unknown texture kind {kind!r}; known kinds: {sorted(TEXTURE_KINDS)}")
     names = inspect.signature(TEXTURE_KINDS[kind]).parameters
     return tuple(n for n in names if n != "seed")
+
+
+def check_texture_size(kind: str, params) -> tuple[int, int]:
+    """(width, height) in texels the procedural texture ``kind`` would have with ``params``,
+    computed without making it; ValueError when it is not a positive size or exceeds
+    MAX_TEXTURE_PIXELS (so the spec is refused before anything is allocated)."""
+    defaults = {n: p.default for n, p in inspect.signature(TEXTURE_KINDS[kind]).parameters.items()}
+    get = lambda n: params.get(n, defaults.get(n))  # noqa: E731
+    if kind == "checkerboard":
+        try:
+            w, h = (int(get(a)) * int(get("px_per_square")) for a in ("squares_u", "squares_v"))
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError("squares_u, squares_v and px_per_square must be whole numbers") from None
+        return _size_wh((w, h))
+    if "size_px" not in defaults:
+        return (0, 0)
+    w, h = _size_wh(get("size_px"))
+    ss = get("supersample") if "supersample" in defaults else 1
+    if isinstance(ss, (int, float)) and ss > 1 and w * h * ss * ss > MAX_TEXTURE_PIXELS:
+        raise ValueError(f"size_px {w} x {h} with supersample {ss} is more than {MAX_TEXTURE_PIXELS:,} pixels")
+    return w, h
 
 
 def make_texture(kind: str, params: dict | None = None, seed: int = 0) -> np.ndarray:

@@ -17,6 +17,8 @@ from typing import Mapping
 
 import numpy as np
 
+from scenegen.dataset.layout import check_listed_names
+
 NO_SURFACE, VISIBLE, OCCLUDED, OUT_OF_FRAME = 0, 1, 2, 3
 STATE_NAMES = {NO_SURFACE: "no_surface", VISIBLE: "visible", OCCLUDED: "occluded", OUT_OF_FRAME: "out_of_frame"}
 
@@ -196,10 +198,15 @@ class CrossviewIndex:
         targets = d.get("targets")
         if not isinstance(targets, list) or not all(isinstance(v, str) for v in targets):
             raise ValueError("targets: expected a list of view names")
-        return cls(pairs=pairs_of("pairs", "i", "j"), flow=pairs_of("flow", "i", "j"),
-                   stereo=pairs_of("stereo", "left_view", "right_view"), targets=tuple(targets),
+        pairs, flow = pairs_of("pairs", "i", "j"), pairs_of("flow", "i", "j")
+        stereo, files = pairs_of("stereo", "left_view", "right_view"), d.get("files", [])
+        if not isinstance(files, (list, tuple)) or not all(isinstance(r, str) for r in files):
+            raise ValueError("files: expected a list of relative paths")
+        check_listed_names("index", views=[v for p in pairs + flow + stereo for v in p] + targets,
+                           paths=files)  # names become paths: checked before any is used
+        return cls(pairs=pairs, flow=flow, stereo=stereo, targets=tuple(targets),
                    occlusion_rel_tol=float(d.get("occlusion_rel_tol", float("nan"))),
-                   pair_info=tuple(dict(e) for e in d["pairs"]), files=tuple(d.get("files", ())))
+                   pair_info=tuple(dict(e) for e in d["pairs"]), files=tuple(files))
 
     def __len__(self) -> int:
         return len(self.pairs)

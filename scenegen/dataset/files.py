@@ -55,13 +55,21 @@ def atomic_write(path, write_fn: Callable[[BinaryIO], None]) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as e:
         try:
             os.unlink(tmp)
         except FileNotFoundError:
             pass
+        if isinstance(e, OSError) and e.errno is not None:
+            raise named_os_error(e, path) from None
         raise
     fsync_dir(path.parent)
+
+
+def named_os_error(e: OSError, path: Path) -> OSError:
+    """The same error naming the file being written (not its temporary file, not nothing: a
+    full disk's write error carries no file name). Its class follows the errno."""
+    return OSError(e.errno, e.strerror or str(e), str(path))
 
 
 def write_payload(f: BinaryIO, data: bytes) -> None:
@@ -97,15 +105,23 @@ def atomic_write_files(items) -> None:
             tmp, path = staged[0]
             os.replace(tmp, path)
             staged.pop(0)
-    except BaseException:
+    except BaseException as e:
         for tmp, _ in staged:
             try:
                 os.unlink(tmp)
             except FileNotFoundError:
                 pass
+        if isinstance(e, OSError) and e.errno is not None and staged:
+            raise named_os_error(e, staged[0][1]) from None
         raise
     for directory in dict.fromkeys(Path(p).parent for p in items):
         fsync_dir(directory)
+
+
+def copy_file(src, dst) -> None:
+    """Copy ``src`` to ``dst`` atomically (an export's copy of a dataset file): a read error names
+    ``src``, a write error (full disk, read-only folder) names ``dst``."""
+    atomic_write_bytes(dst, Path(src).read_bytes())
 
 
 def remove_stale_temp_files(root) -> list[Path]:

@@ -85,6 +85,28 @@ def check_rel_path(rel: str) -> str:
     return rel
 
 
+def check_listed_names(source: str, *, views=(), paths=(), names=()) -> None:
+    """Check names *read from a file* (a manifest, cameras.json, the cross-view index) before any
+    of them reaches a path: every view against :func:`check_view_name`, every relative path
+    against :func:`check_rel_path`. ValueError naming ``source`` and the first bad name: a
+    crafted file cannot make a reader (or an export) read or write outside the dataset."""
+    for v in views:
+        try:
+            check_view_name(v)
+        except ValueError as e:
+            raise ValueError(f"{source}: lists an invalid view name: {e}") from None
+    for r in paths:
+        try:
+            check_rel_path(r)
+        except ValueError as e:
+            raise ValueError(f"{source}: lists an invalid path: {e}") from None
+    for kind, n in names:  # other names tools make files of (camera, rig, rig member, scene)
+        try:
+            check_name(kind, n)
+        except ValueError as e:
+            raise ValueError(f"{source}: lists an invalid {kind} name: {e}") from None
+
+
 # --- per view ----------------------------------------------------------------------------------
 def view_paths(view: str) -> dict[str, str]:
     """Relative paths of a view's standard files: keys image, linear, truth, ids, valid."""

@@ -30,6 +30,7 @@ from scenegen.dataset.layout import (
     MESHES_DIR,
     TARGETS_DIR,
     VIGNETTING_CHANNEL,
+    check_listed_names,
     check_rel_path,
     mesh_path,
     names_under,
@@ -55,6 +56,9 @@ class Dataset:
     def __init__(self, out_dir):
         self.root = Path(out_dir)
         self.manifest: dict = load_current_manifest(self.root)  # with an unfinished run's journal
+        _check_names(f"{self.root / 'manifest.json'}", views=self.manifest["views"],
+                     paths=list(self.manifest["files"])
+                     + [r for e in self.manifest["views"].values() for r in e.get("files", ())])
         self._cameras: dict | None = None
         self._crossview: CrossviewTruth | None = None
 
@@ -98,7 +102,16 @@ class Dataset:
         """The parsed cameras.json (empty views if the run wrote none)."""
         if self._cameras is None:
             p = self.root / CAMERAS
-            self._cameras = read_json(p) if p.is_file() else {"view_order": [], "views": {}, "spec": None}
+            doc = read_json(p) if p.is_file() else {"view_order": [], "views": {}, "spec": None}
+            if not (isinstance(doc, dict) and isinstance(doc.get("view_order"), list)
+                    and isinstance(doc.get("views"), dict)):
+                raise DatasetError(f"{p}: expected a JSON object with 'view_order' (a list) and 'views'")
+            infos = [e for e in doc["views"].values() if isinstance(e, dict)]
+            _check_names(str(p), views=list(doc["view_order"]) + list(doc["views"]),
+                         names=[(what, e[k]) for e in infos for k, what in
+                                (("camera_name", "camera"), ("rig", "rig"), ("rig_member", "rig member"))
+                                if e.get(k) is not None])
+            self._cameras = doc
         return self._cameras
 
     @property
@@ -259,3 +272,11 @@ class Dataset:
         if self._crossview is None:
             self._crossview = CrossviewTruth(self)
         return self._crossview
+
+
+def _check_names(source: str, *, views=(), paths=(), names=()) -> None:
+    """Every name a dataset file lists is checked once, when the file is read (DatasetError)."""
+    try:
+        check_listed_names(source, views=views, paths=paths, names=names)
+    except ValueError as e:
+        raise DatasetError(str(e)) from None

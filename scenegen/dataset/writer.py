@@ -42,6 +42,7 @@ from scenegen.dataset.layout import (
     mesh_path,
     view_paths,
 )
+from scenegen.dataset.lock import LOCK_NAME, DatasetLock
 from scenegen.dataset.manifest import (
     FORMAT,
     FORMAT_VERSION,
@@ -128,7 +129,8 @@ def software_versions() -> dict[str, str]:
 
 
 class DatasetWriter:
-    """Writes a dataset directory; owns its manifest (use one writer per directory).
+    """Writes a dataset directory; owns its manifest and, until :meth:`close`, the folder's lock
+    (:mod:`scenegen.dataset.lock`: a second writer on the folder fails naming this one).
 
     Typical use::
 
@@ -175,6 +177,15 @@ class DatasetWriter:
         self._manifest_sha = ""  # manifest_sha256 of manifest.json as last written
         self.journal_bytes = 0  # bytes appended to journals by this writer (benchmarks)
 
+        self._lock = DatasetLock.acquire(self.root)  # one writer per folder, before anything is touched
+        try:
+            self._open(identity, resume)
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def _open(self, identity: dict, resume: bool) -> None:
+        """Read (resume) or start the folder's manifest; the lock is held."""
         has_manifest = (self.root / MANIFEST).is_file()
         if resume and self.root.is_dir():
             remove_stale_temp_files(self.root)
@@ -193,7 +204,7 @@ class DatasetWriter:
             records = [] if journal is None else pending_records(m, journal, str(self.root / MANIFEST_JOURNAL))
             self._replay(records)
             resumed_unchanged = not records  # manifest.json already holds this state, byte for byte
-        elif self.root.exists() and any(self.root.iterdir()):
+        elif self.root.exists() and any(p.name != LOCK_NAME for p in self.root.iterdir()):
             if (self.root / MANIFEST_JOURNAL).is_file() and not has_manifest:
                 hint = f"it has a {MANIFEST_JOURNAL} but no {MANIFEST}: the manifest was removed"
             else:
@@ -318,13 +329,27 @@ class DatasetWriter:
 
     def close(self) -> None:
         """Compact the journal into manifest.json (atomically) and remove it: a finished dataset."""
-        self._write_manifest()
+        try:
+            self._write_manifest()
+        finally:
+            self._lock.release()
+
+    def abort(self) -> None:
+        """Release the folder without compacting (after a failure: the journal already holds
+        every recorded view, so ``--resume`` continues from here)."""
+        if self._journal is not None:
+            self._journal.close()
+            self._journal = None
+        self._lock.release()
 
     def __enter__(self) -> "DatasetWriter":
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
     # --- internals
     def _check_rerecord(self, view: str, hashes: Mapping[str, str]) -> None:

@@ -6,8 +6,7 @@ one physical camera) and the rendered images as they are; the model's rules are 
 """
 from __future__ import annotations
 
-import shutil
-
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.layout import view_paths
 from scenegen.export.colmap_model import write_model
 
@@ -19,5 +18,5 @@ def export(ds, dest, progress=None) -> dict:
     counts = write_model(ds, dest, "", cams, poses, progress)
     (dest / "images").mkdir(exist_ok=True)
     for v in ds.views:
-        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
+        copy_file(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     return {"files": 3 + len(cams), **counts}

@@ -51,7 +51,9 @@ def staged_dest(dest: Path):
         if dest.exists():
             dest.rmdir()
         stage.rename(dest)
-    except BaseException:
+    except BaseException as e:
+        if isinstance(e, OSError) and isinstance(e.filename, str) and e.filename.startswith(str(stage)):
+            e.filename = str(dest) + e.filename[len(str(stage)):]  # name the file the user asked for
         if stage.exists():
             shutil.rmtree(stage)
         for p in reversed(created):  # the folders made for it, innermost first, if still empty

@@ -12,12 +12,11 @@ projected through the pinhole cameras.
 """
 from __future__ import annotations
 
-import shutil
-
 import cv2
 import numpy as np
 
 from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.layout import view_paths
 from scenegen.export.colmap_model import write_model
 from scenegen.export.common import each, write
@@ -50,7 +49,7 @@ def export(ds, dest, progress=None) -> dict:
         cam, poses[v] = ds.camera(v)
         cams[v] = pin = pinhole_of(cam)
         if pin == cam:
-            shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
+            copy_file(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
         else:
             write(dest, f"images/{v}.png", encode_png(undistorted_image(ds.image(v), cam, pin)))
             resampled += 1

@@ -18,11 +18,11 @@ folder and views.
 from __future__ import annotations
 
 import json
-import shutil
 
 import numpy as np
 
 from scenegen.dataset.cameras import camera_of
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.layout import stereo_dir, stereo_path
 from scenegen.export.common import each, stereo_frames, write
@@ -73,7 +73,7 @@ def export(ds, dest, progress=None) -> dict:
             write(dest, f"training/{folder}/{tag}_10.png", encode_png(to_uint8(fr.image(side))))
         for kind in ("occ", "noc"):
             (dest / f"training/disp_{kind}_0").mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(ds.path(stereo_path(fr.left_view, f"disparity_{kind}", "left")),
+            copy_file(ds.path(stereo_path(fr.left_view, f"disparity_{kind}", "left")),
                             dest / f"training/disp_{kind}_0/{tag}_10.png")
         om = obj_map(ds, fr)
         if om is not None:

@@ -11,10 +11,10 @@ Disparity relates to depth by Z = baseline * f / (d + doffs).
 from __future__ import annotations
 
 import math
-import shutil
 
 import numpy as np
 
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.crossview import VISIBLE
 from scenegen.dataset.layout import stereo_path
@@ -35,7 +35,7 @@ def export(ds, dest, progress=None) -> dict:
         (dest / name).mkdir(parents=True, exist_ok=True)
         for key, side, dst in (("image", "left", "im0.png"), ("image", "right", "im1.png"),
                                ("disparity_pfm", "left", "disp0GT.pfm"), ("disparity_pfm", "right", "disp1GT.pfm")):
-            shutil.copyfile(ds.path(stereo_path(fr.left_view, key, side)), dest / name / dst)
+            copy_file(ds.path(stereo_path(fr.left_view, key, side)), dest / name / dst)
         calib = fr.calib
         for k, side in enumerate(("left", "right")):
             d = fr.disparity(side)

@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 
 import numpy as np
 
 from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.files import copy_file
 from scenegen.dataset.layout import view_paths
 from scenegen.export.common import depth_png16, each, write
 from scenegen.export.errors import ExportError
@@ -84,7 +84,7 @@ def export(ds, dest, progress=None) -> dict:
                        "depth_path": f"depth/{v}.png",
                        "mask_path": f"masks/{v}.png", **intr,
                        "transform_matrix": opengl_cam_to_world(pose).tolist()})
-        shutil.copyfile(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
+        copy_file(ds.path(view_paths(v)["image"]), dest / "images" / f"{v}.png")
     parts = split(list(ds.views))
     shared = {}
     if len(set(all_intr)) == 1:

@@ -19,6 +19,7 @@ from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entries
 from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
+from scenegen.spec.assets_check import located
 
 
 @dataclass
@@ -87,7 +88,8 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     d: dict = {"type": "scene", "integrator": {"type": "path", "max_depth": int(max_depth)}}
     object_ids, instance_ids = {}, {}
     for obj in spec.objects:
-        entries = object_entries(obj, object_key(obj), built)
+        with located(obj, f"object {obj.name!r}"):  # asset errors name the spec's file:line
+            entries = object_entries(obj, object_key(obj), built)
         d.update(entries)
         for key, entry in entries.items():
             if obj.motion is not None and not obj.motion.is_static:

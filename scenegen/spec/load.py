@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from scenegen.errors import SpecError
 from scenegen.located_yaml import Document
+from scenegen.located_yaml.source import read_source
 from scenegen.spec.model.scene import SceneSpec
 from scenegen.spec.parse.context import derive_seed
 from scenegen.spec.parse.scene import TOP_LEVEL_KEYS, parse_document
@@ -17,10 +17,7 @@ from scenegen.spec.parse.scene import TOP_LEVEL_KEYS, parse_document
 def load_spec(path) -> SceneSpec:
     """Read and validate a YAML scene spec. Relative file paths in it resolve against its folder."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise SpecError(f"cannot read the spec file: {e.strerror or e}", file=str(path)) from None
+    text = read_source(p, "spec file")  # size limit, UTF-8, one-line errors
     return parse_spec(text, file=str(path), base_dir=p.resolve().parent)
 
 

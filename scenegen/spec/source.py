@@ -5,7 +5,7 @@ import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from scenegen.errors import SpecError
+from scenegen.located_yaml.source import read_source
 from scenegen.spec.load import parse_spec
 from scenegen.spec.model.scene import SceneSpec
 from scenegen.spec.variants import derive_variant
@@ -27,10 +27,7 @@ class SpecSource:
     @classmethod
     def from_path(cls, path, variant_index: int | None = None) -> "SpecSource":
         p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            raise SpecError(f"cannot read the spec file: {getattr(e, 'strerror', None) or e}", file=str(path)) from None
+        text = read_source(p, "spec file")  # size limit, UTF-8, one-line errors
         return cls(text, str(path), str(p.resolve().parent), variant_index)
 
     @property

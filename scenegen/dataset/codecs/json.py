@@ -56,4 +56,7 @@ def read_json(path) -> Any:
 
 def decode_json(data: bytes) -> Any:
     """Parse UTF-8 JSON bytes (ValueError for invalid JSON or text)."""
-    return json.loads(data.decode("utf-8"))
+    try:
+        return json.loads(data.decode("utf-8"))
+    except RecursionError:  # a hostile file: arrays nested thousands deep
+        raise ValueError("invalid JSON: nested too deeply") from None

@@ -74,7 +74,12 @@ class Camera:
 
     @classmethod
     def from_opencv(cls, K, dist, size) -> "Camera":
-        """From an OpenCV camera matrix K (3x3, skew in K[0, 1]), distortion vector and (W, H)."""
+        """From an OpenCV camera matrix K (3x3, skew in K[0, 1]), distortion vector and (W, H).
+        The vector has one of OpenCV's lengths (4, 5, 8, 12, 14) even when every coefficient is 0
+        (it then is a pinhole): ValueError otherwise."""
+        d = () if dist is None else tuple(np.asarray(dist, float).ravel())
+        if d:
+            camera_model("opencv").normalise_dist("opencv", d)
         return cls(*interop.opencv_camera_args(K, dist, size))
 
     @classmethod

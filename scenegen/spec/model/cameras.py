@@ -13,6 +13,7 @@ from scenegen.geometry.camera import MODEL_NAMES, Camera
 from scenegen.geometry.pose import Rigid3
 from scenegen.imaging import ImagingParams, RawOutput, SensorParams
 from scenegen.spec.model.meta import describe_foreign, meta, param, part, where_field
+from scenegen.spec.model.limits import MAX_IMAGE_SIDE_PX
 
 RIG_TYPES = ("stereo", "multi")
 _PX = "pixels"
@@ -28,8 +29,8 @@ class CameraSpec:
 
     name: str  # key under `cameras:`
     model: str = param("pinhole", unit="camera model", choices=MODEL_NAMES)
-    width: int = param(unit="pixels", lo=1)  # YAML `size: [W, H]`, whole pixels
-    height: int = param(unit="pixels", lo=1)
+    width: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX)  # YAML `size: [W, H]`, whole pixels
+    height: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX)
     fx: float = param(unit=_PX, lo=0.0, lo_open=True, derived="from fov_deg")  # focal length
     # along u
     fy: float = param(unit=_PX, lo=0.0, lo_open=True, derived="fx")  # focal length along v

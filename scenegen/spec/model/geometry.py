@@ -12,6 +12,7 @@ from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec.model.materials import Material
 from scenegen.spec.model.meta import ID_MAX, SEED_MAX, param, part, where_field
+from scenegen.spec.model.limits import MAX_BOARD_SIDE
 
 SHAPE_KINDS = ("plane", "box", "sphere", "cylinder", "torus", "blob")
 MESH_SUFFIXES = (".ply", ".obj", ".glb", ".gltf", ".stl")
@@ -110,9 +111,9 @@ class CheckerboardTarget:
     """A chessboard of (inner_cols + 1) x (inner_rows + 1) squares, centred on the object origin
     in the z = 0 plane, printed side facing +z; a white margin around it."""
 
-    inner_cols: int = param(unit="inner corners", label="", lo=2)  # along object x
+    inner_cols: int = param(unit="inner corners", label="", lo=2, hi=MAX_BOARD_SIDE)  # along object x
     # (cv2.findChessboardCorners patternSize[0])
-    inner_rows: int = param(unit="inner corners", label="", lo=2)  # along object y
+    inner_rows: int = param(unit="inner corners", label="", lo=2, hi=MAX_BOARD_SIDE)  # along object y
     square_m: float = param(**_POS_M)  # side of one square
     margin_m: float = param(unit="metres", lo=0.0, derived=_MARGIN)  # white border around the
     # squares
@@ -123,8 +124,8 @@ class CheckerboardTarget:
 class CharucoTarget:
     """A ChArUco board (cv2.aruco.CharucoBoard), centred on the object origin, z = 0, facing +z."""
 
-    squares_x: int = param(unit="squares", label="", lo=2)  # along object x
-    squares_y: int = param(unit="squares", label="", lo=2)  # along object y
+    squares_x: int = param(unit="squares", label="", lo=2, hi=MAX_BOARD_SIDE)  # along object x
+    squares_y: int = param(unit="squares", label="", lo=2, hi=MAX_BOARD_SIDE)  # along object y
     square_m: float = param(**_POS_M)  # side of one square
     marker_m: float = param(**_POS_M)  # side of one ArUco marker (< square_m)
     dictionary: str = param(unit="ArUco dictionary", choices=tuple(ARUCO_DICTIONARIES))
@@ -139,8 +140,8 @@ class CharucoTarget:
 class ArucoGridTarget:
     """An ArUco grid board (cv2.aruco.GridBoard), centred on the object origin, z = 0, facing +z."""
 
-    markers_x: int = param(unit="markers", label="", lo=1)  # along object x
-    markers_y: int = param(unit="markers", label="", lo=1)  # along object y
+    markers_x: int = param(unit="markers", label="", lo=1, hi=MAX_BOARD_SIDE)  # along object x
+    markers_y: int = param(unit="markers", label="", lo=1, hi=MAX_BOARD_SIDE)  # along object y
     marker_m: float = param(**_POS_M)  # side of one marker
     separation_m: float = param(**_POS_M)  # gap between neighbouring markers
     dictionary: str = param(unit="ArUco dictionary", choices=tuple(ARUCO_DICTIONARIES))

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from scenegen.errors import Where
 from scenegen.geometry.color import BIT_DEPTHS
 from scenegen.spec.model.meta import SEED_MAX, param, where_field
+from scenegen.spec.model.limits import MAX_SPP
 
 #: Allowed values of the enumerations, in the order the docs list them.
 RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
@@ -41,7 +42,7 @@ def effective_spp(sampler: str, spp: int) -> int:
 
 @dataclass(frozen=True, kw_only=True)
 class RenderSettings:
-    spp: int = param(64, unit="samples per pixel", lo=1)  # asked for; Mitsuba may round it up
+    spp: int = param(64, unit="samples per pixel", lo=1, hi=MAX_SPP)  # asked for; Mitsuba may round it up
     # (effective_spp)
     max_depth: int = param(6, unit="path segments, -1 = unbounded", lo=-1)  # longest light path
     # in segments (Mitsuba max_depth; -1 = unbounded; 0 is rejected)

@@ -7,10 +7,11 @@ from typing import Any, Mapping, Union
 from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec.model.meta import SEED_MAX, WORLD_UP, param, part, where_field
+from scenegen.spec.model.limits import MAX_VIEWS
 
 _M = "metres"
 _POS_M = dict(unit=_M, lo=0.0, lo_open=True)
-_COUNT = dict(unit="views", label="", lo=1)
+_COUNT = dict(unit="views", label="", lo=1, hi=MAX_VIEWS)
 _UP = dict(unit="direction")  # world direction shown up in the image
 _SEED = dict(unit="seed", label="", lo=0, hi=SEED_MAX, derived="seed32(scene seed, field path)")
 

@@ -9,6 +9,7 @@ from scenegen.geometry.camera import MODELS, CameraModel
 from scenegen.geometry.camera.validity import FoldError
 from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model.cameras import CameraSpec
+from scenegen.spec.model.limits import MAX_IMAGE_PIXELS
 from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.imaging import parse_imaging
@@ -37,11 +38,17 @@ def parse_camera(node: Node, name: str, ctx: ParseContext) -> CameraSpec:
     cm = MODELS[model]
     size_node = f.get("size")
     size = size_node.as_floats(2, "width, height in pixels")
-    smallest = field_info(C, "width").meta.lo
+    smallest, largest = field_info(C, "width").meta.lo, field_info(C, "width").meta.hi
     for item, v in zip(size_node.items(), size):
         if not v.is_integer() or v < smallest:
             raise item.error(f"expected a positive whole number of pixels, got {v:g}")
+        if v > largest:
+            raise item.error(f"expected at most {largest} pixels (MAX_IMAGE_SIDE_PX, docs/scene_spec.md "
+                             f"'Limits'), got {v:.12g}")
     W, H = int(size[0]), int(size[1])
+    if W * H > MAX_IMAGE_PIXELS:
+        raise size_node.error(f"expected at most {MAX_IMAGE_PIXELS:,} pixels per image (MAX_IMAGE_PIXELS, "
+                              f"docs/scene_spec.md 'Limits'), got {W} x {H} = {W * H:,}")
     if "fov_deg" in f:
         for bad in ("fx", "fy"):
             if bad in f:

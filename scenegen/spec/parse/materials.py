@@ -3,7 +3,7 @@ principled, each with optional normal/bump maps and an alpha mask; image and pro
 textures (parameter names checked against :mod:`scenegen.assets.textures`)."""
 from __future__ import annotations
 
-from scenegen.assets.textures import texture_params
+from scenegen.assets.textures import check_texture_size, texture_params
 from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model import materials as mm
 from scenegen.spec.model.meta import field_info, frozen_mapping
@@ -38,6 +38,10 @@ def parse_texture(node: Node, ctx: ParseContext) -> mm.Texture:
         pf = f.get("params").as_mapping("a mapping of texture parameters")
         pf.check(optional=texture_params(kind))  # names only; values are make_texture's business
         params = f.get("params").plain()
+        try:
+            check_texture_size(kind, params)  # before anything is allocated (MAX_TEXTURE_PIXELS)
+        except ValueError as e:
+            raise f.get("params").error(f"{e} (docs/scene_spec.md 'Limits')") from None
     seed = seed_or_none(f, mm.Texture)
     if seed is None:
         seed = ctx.seed_for(node.path)

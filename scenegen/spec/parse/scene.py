@@ -8,6 +8,7 @@ from typing import Callable
 
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Fields, Node
+from scenegen.spec.model.limits import MAX_VIEWS
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.model.scene import SceneSpec
 from scenegen.spec.parse.cameras import parse_camera
@@ -55,6 +56,7 @@ def parse_document(doc: Document) -> SceneSpec:
     unique_names(f.get("lights"), lights, "light")
     ctx = ctx.but(lights=tuple(lights))  # named by view sets' `lights:`
     view_sets = list_section(f, "views", parse_view_set, ctx)
+    check_view_count(f.get("views"), view_sets, ctx.rigs)  # before any pose is made
     crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
@@ -91,10 +93,26 @@ def list_section(f: Fields, key: str, parse: Callable, ctx: ParseContext) -> lis
 
 def unique_names(section: Node | None, things, what: str) -> None:
     seen: dict[str, int | None] = {}
-    for i, thing in enumerate(things):
-        item = section.items()[i]
+    items = section.items() if things else []  # once: linear in the number of things
+    for item, thing in zip(items, things):
         name_node = item.as_mapping().get("name") or item
         if thing.name in seen:
             raise name_node.error(f"duplicate {what} name {thing.name!r} (first at line "
                                   f"{seen[thing.name]})")
         seen[thing.name] = name_node.line
+
+
+def planned_views(vs) -> int:
+    """How many views a view set makes (rig members counted), without making them."""
+    p = vs.placement
+    n = {"orbit": lambda: p.count * len(p.elevations_deg), "look_at": lambda: len(p.entries),
+         "poses": lambda: len(p.world_from_cam)}.get(p.kind, lambda: p.count)()
+    return n
+
+
+def check_view_count(node, view_sets, rigs) -> None:
+    total = sum(planned_views(vs) * (len(rigs[vs.rig].members) if vs.rig is not None else 1)
+                for vs in view_sets)
+    if total > MAX_VIEWS:
+        raise node.error(f"the view sets make {total:,} views; at most {MAX_VIEWS:,} per run (MAX_VIEWS, "
+                         "docs/scene_spec.md 'Limits'): split the run into several datasets")

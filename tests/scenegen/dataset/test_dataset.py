@@ -165,7 +165,7 @@ class TestDeterminism:
         w.write_mesh("box", trimesh.creation.box(extents=(1, 2, 3)))
         for i, v in enumerate(VIEWS):
             w.record_view(v, ds.write_view_files(out, v, **make_view(i)))
-        w.close()
+        w.close()  # compacts the journal and releases the folder's lock
         assert all_bytes(out) == all_bytes(complete)
 
 
@@ -201,7 +201,7 @@ class TestResume:
         written = []
         orig = w.write_view
         w.write_view = lambda v, **kw: (written.append(v), orig(v, **kw))
-        write_dataset(out, writer=w)
+        write_dataset(out, writer=w).close()
         assert written == VIEWS[2:]
         assert all_bytes(out) == all_bytes(complete)
         assert ds.verify(out).ok

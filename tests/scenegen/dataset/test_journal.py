@@ -32,6 +32,7 @@ def crashed_after(out: Path, n_views: int):
     w.write_mesh("box", trimesh.creation.box(extents=(1, 2, 3)))
     for v in VIEWS[:n_views]:
         w.write_view(v, **make_view(VIEWS.index(v)))
+    w.abort()  # the kernel releases a killed process's lock; the journal stays as it was
     return w  # never closed: manifest.json + journal, as a killed process leaves them
 
 
@@ -168,6 +169,7 @@ def test_journal_of_another_manifest_is_refused(tmp_path):
     older = (out / MANIFEST).read_bytes()
     w2 = new_writer(out, resume=True)  # compacts: manifest.json now lists the two views
     w2.write_view(VIEWS[2], **make_view(2))  # a new journal, extending the new manifest
+    w2.abort()  # killed
     (out / MANIFEST).write_bytes(older)  # someone puts the old manifest back
     with pytest.raises(ds.DatasetError, match="extends another"):
         new_writer(out, resume=True)
@@ -179,6 +181,7 @@ def test_stale_journal_after_a_crash_during_compaction_is_dropped(tmp_path, comp
     w = crashed_after(out, 5)
     stale = (out / MANIFEST_JOURNAL).read_bytes()
     w2 = new_writer(out, resume=True)  # compacts and removes the journal
+    w2.abort()  # killed
     (out / MANIFEST_JOURNAL).write_bytes(stale)  # as if killed between the rewrite and the unlink
     assert ds.Dataset(out).views == tuple(VIEWS)
     write_dataset(out, writer=new_writer(out, resume=True))

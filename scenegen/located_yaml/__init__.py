@@ -1,4 +1,5 @@
-"""Typed, located access to a YAML node tree (SafeLoader only).
+"""Typed, located access to a YAML node tree (SafeLoader only; composed by :mod:`.compose`,
+which refuses tags, nesting and alias expansions a hostile document could use).
 
 The YAML text is composed, not constructed, so every value keeps its line. ``Node`` wraps one
 value with its field path; its ``as_*`` readers check the type and range and raise
@@ -16,9 +17,14 @@ from typing import Iterable, Sequence
 import yaml
 
 from scenegen.errors import SpecError, Where
+from scenegen.located_yaml.compose import compose
+from scenegen.located_yaml.text import non_finite_text, number_text, source_text
 
 _NUMBER_RE = re.compile(r"^[-+]?(\d[\d_]*\.?[\d_]*|\.\d[\d_]*)([eE][-+]?\d+)?$")
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+#: Longest name (scene, object, camera, ...): names become file names; equal to
+#: scenegen.dataset.layout.MAX_NAME_LEN (tests/hostile/test_hostile_limits.py checks).
+MAX_NAME_LEN = 128
 
 
 def suggest(word: str, choices: Iterable[str]) -> str:
@@ -38,19 +44,7 @@ class Document:
         self.file = file
         self.base_dir = base_dir
         self._pairs: dict[int, list] = {}
-        self.loader = yaml.SafeLoader(text)
-        try:
-            try:
-                root = self.loader.get_single_node()
-            finally:
-                self.loader.dispose()
-        except yaml.MarkedYAMLError as e:
-            mark = e.problem_mark or e.context_mark
-            what = " ".join(p for p in (e.context, e.problem) if p)
-            raise SpecError(f"invalid YAML: {what}", file=file,
-                            line=mark.line + 1 if mark else None) from None
-        except yaml.YAMLError as e:
-            raise SpecError(f"invalid YAML: {e}", file=file) from None
+        self.loader, root = compose(text, file)
         self.root = Node(self, root, "")
 
     def pairs(self, node: yaml.MappingNode) -> list[tuple[yaml.Node, yaml.Node, bool]]:
@@ -115,7 +109,11 @@ class Node:
         """The Python value of a scalar node (SafeLoader's rules)."""
         if self.node is None:
             return None
-        return self.doc.loader.construct_object(self.node, deep=True)
+        try:
+            return self.doc.loader.construct_object(self.node, deep=True)
+        except (yaml.YAMLError, ValueError, OverflowError) as e:  # e.g. the date 2001-13-45
+            problem = getattr(e, "problem", None) or str(e)
+            raise self.error(f"cannot read the value {source_text(self.node) or 'here'}: {problem}") from None
 
     def describe(self) -> str:
         """How the value reads, for 'got ...' in messages."""
@@ -125,9 +123,9 @@ class Node:
         if isinstance(n, yaml.ScalarNode):
             text = repr(self.scalar())
         elif isinstance(n, yaml.SequenceNode):
-            text = _source(n) or f"a list of {len(n.value)} items"
+            text = source_text(n) or f"a list of {len(n.value)} items"
         else:
-            return "a mapping" if not _source(n) else f"a mapping {_source(n)}"
+            return "a mapping" if not source_text(n) else f"a mapping {source_text(n)}"
         return text if len(text) <= 60 else text[:57] + "..."
 
     # -- readers -------------------------------------------------------------------------------
@@ -139,6 +137,9 @@ class Node:
 
     def as_name(self, what: str = "a name") -> str:
         v = self.as_str(what)
+        if len(v) > MAX_NAME_LEN:
+            raise self.error(f"expected {what} of at most {MAX_NAME_LEN} characters (names become file "
+                             f"names), got {len(v)} characters {v[:20]!r}...")
         if not NAME_RE.match(v):
             raise self.error(f"expected {what} made of letters, digits, '_' and '-' "
                              f"(starting with a letter or digit), got {v!r}")
@@ -174,21 +175,32 @@ class Node:
             return float(v.replace("_", ""))
         return None
 
+    def _finite(self, unit: str) -> float:
+        """The number as a finite float; 'expected a (finite) number' naming NaN, infinity or a
+        value beyond float64 otherwise."""
+        v = self._number()
+        if v is None:
+            raise self.error(f"expected a number{unit}, got {self.describe()}")
+        try:
+            f = float(v)
+        except OverflowError:
+            f = math.inf
+        if not math.isfinite(f):
+            raise self.error(f"expected a finite number{unit}, got {non_finite_text(self.node, v)}")
+        return f
+
     def as_float(self, unit: str = "", *, lo: float | None = None, hi: float | None = None,
                  lo_open: bool = False, hi_open: bool = False) -> float:
-        v = self._number()
         u = f" ({unit})" if unit else ""
-        if v is None:
-            raise self.error(f"expected a number{u}, got {self.describe()}")
-        v = float(v)
-        if not math.isfinite(v):
-            raise self.error(f"expected a finite number{u}, got {self.describe()}")
+        v = self._finite(u)
         _check_range(self, v, lo, hi, lo_open, hi_open, u)
         return v
 
     def as_int(self, unit: str = "", *, lo: int | None = None, hi: int | None = None) -> int:
         v = self._number()
         u = f" ({unit})" if unit else ""
+        if isinstance(v, float) and not math.isfinite(v):
+            raise self.error(f"expected an integer{u}, got {non_finite_text(self.node, v)}")
         if v is None or isinstance(v, float) and not v.is_integer():
             raise self.error(f"expected an integer{u}, got {self.describe()}")
         v = int(v)
@@ -216,10 +228,10 @@ class Node:
         if self.is_sequence:
             for item in self.items():
                 v = item._number()
-                if v is None or not math.isfinite(float(v)):
+                if v is None:
                     vals = None
                     break
-                vals.append(float(v))
+                vals.append(item._finite(u))  # NaN, infinity: named at the item
         if (not self.is_sequence or vals is None or (counts and len(vals) not in counts)
                 or (counts is None and not vals)):
             got = self.describe()
@@ -248,10 +260,18 @@ class Node:
     def as_path(self, suffixes: Sequence[str], what: str) -> tuple[Path, str]:
         """An existing file, relative to the spec's directory: (absolute path, as written)."""
         text = self.as_str(f"a file path ({what})")
+        if "\x00" in text or not text.strip():
+            raise self.error(f"expected a file path ({what}), got {text!r}"
+                             + (" (a path cannot contain a NUL byte)" if "\x00" in text else ""))
         p = Path(text).expanduser()
-        full = (p if p.is_absolute() else self.doc.base_dir / p).resolve()
+        try:
+            full = (p if p.is_absolute() else self.doc.base_dir / p).resolve()
+        except (OSError, RuntimeError) as e:  # a symlink loop, a name too long
+            raise self.error(f"cannot resolve the path {text!r}: {e}") from None
         if suffixes and full.suffix.lower() not in suffixes:
             raise self.error(f"expected a {what} file ({', '.join(suffixes)}), got {text!r}")
+        if full.is_dir():
+            raise self.error(f"{text!r} is a directory, expected a {what} file (looked at {full})")
         if not full.is_file():
             raise self.error(f"file not found: {text!r} (looked for {full})")
         return full, text
@@ -279,19 +299,10 @@ def _check_range(node: Node, v, lo, hi, lo_open, hi_open, u):
     if bad_lo or bad_hi:
         parts = []
         if lo is not None:
-            parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+            parts.append(f"{'>' if lo_open else '>='} {number_text(lo)}")
         if hi is not None:
-            parts.append(f"{'<' if hi_open else '<='} {hi:g}")
-        raise node.error(f"expected a value {' and '.join(parts)}{u}, got {v:g}")
-
-
-def _source(n: yaml.Node) -> str | None:
-    """The node's own text when it is short and on one line (flow style), else None."""
-    s, e = n.start_mark, n.end_mark
-    if s.buffer is None or s.line != e.line:
-        return None
-    text = s.buffer[s.index:e.index].strip()
-    return text if 0 < len(text) <= 60 else None
+            parts.append(f"{'<' if hi_open else '<='} {number_text(hi)}")
+        raise node.error(f"expected a value {' and '.join(parts)}{u}, got {number_text(v)}")
 
 
 class Fields:
