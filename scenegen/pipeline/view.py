@@ -29,7 +29,9 @@ def rolling_shutter_rows(built, view):
 
 def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
     """The truth pass of a view: per-row poses for a rolling shutter; range and depth_z in
-    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``."""
+    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``.
+    A sequence's frame is cast at its time (the scene's objects moved there)."""
+    built.set_time(getattr(view, "time_s", None))
     return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view),
                        as_stored=as_stored)
 
@@ -37,6 +39,7 @@ def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
     :func:`scenegen.dataset.writer.encode_view`; ``index`` is the view's position in the run."""
+    built.set_time(getattr(v, "time_s", None))  # a sequence's frame: its objects at its time
     linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
                           light_scales=v.light_scales)
     truth = view_truth(built, v, as_stored=True)

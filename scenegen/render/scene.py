@@ -14,11 +14,13 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast, sensor as sensor_mod
+from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entry
 from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
+from scenegen.spec.timeline import Timeline, is_animated
 
 
 @dataclass
@@ -38,6 +40,9 @@ class LoadedScene:
     emitters: list = field(default_factory=list)  # per spec light, spec order: (Mitsuba key of
     # its power, loaded value = spec power, key of its sampling weight, loaded weight)
     light_scales: tuple = ()  # factor on each spec light's power now in the loaded scene
+    timeline: object = None  # scenegen.spec.timeline.Timeline of a sequence, else None
+    animated: list = field(default_factory=list)  # objects placed per time (animate.Animated)
+    time_s: float | None = None  # the clock time the animated objects are at (None: frame 0)
 
     @property
     def variant(self) -> str:
@@ -45,6 +50,14 @@ class LoadedScene:
         return mi.variant()
 
     # --- the door: everything the pipeline asks of Mitsuba
+    def set_time(self, t_s: float | None) -> None:
+        """Move the sequence's objects to time ``t_s`` of the clock (renders, truth and
+        visibility casts then see them there); None or a static scene: nothing to do."""
+        if t_s is None or not self.animated or self.time_s == float(t_s):
+            return
+        place_animated(self, float(t_s))
+        self.time_s = float(t_s)
+
     def render(self, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int, motion=None,
                light_scales=None) -> np.ndarray:
         """Linear float32 (H, W, 3) of a view (:func:`scenegen.render.frames.render_view`)."""
@@ -86,13 +99,17 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
         d[key] = object_entry(obj, built)
         if obj.motion is not None and not obj.motion.is_static:
             built.moving.append(moving_entry(key, obj, d[key], built.meshes_world[obj.name]))
+        if is_animated(obj):
+            built.animated.append(animated_entry(key, obj, d[key], built.meshes_world[obj.name]))
         object_ids[key] = obj.object_id
         instance_ids[key] = obj.instance_id
         built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
                               "kind": type(obj.geometry).__name__.lower()})
     for i, light in enumerate(spec.lights):
         d[light_key(i)] = light_entry(light)
-    built.motion_subframes = spec.render.motion_subframes if built.moving else 1
+    if built.animated:
+        built.timeline = Timeline(spec)
+    built.motion_subframes = spec.render.motion_subframes if built.moving or built.animated else 1
     for name, cam_spec in spec.cameras.items():
         cam = cam_spec.to_camera()
         built.cameras[name] = cam
@@ -105,6 +122,9 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     built.light_scales = (1.0,) * len(spec.lights)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
+    if built.animated:  # at frame 0, where the geometry was placed, hiding what is absent then
+        built.time_s = float(spec.sequence.timestamps_s[0])
+        place_animated(built, built.time_s)
     for cam in built.cameras.values():
         prepare_camera(cam)  # the truth pass's ray table, made here rather than in frame 0
     return built

@@ -39,11 +39,15 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
     frame = 0
     for set_index, (vs, poses) in enumerate(zip(spec.view_sets, per_set)):
         scales = view_set_light_scales(spec, vs)
-        for world_from_x in poses:
+        times = vs.placement.times_s if isinstance(vs.placement, m.TrajectoryPath) else None
+        for k, world_from_x in enumerate(poses):
+            time_s = None if times is None else float(times[k])
+            motion = vs.motion if times is None else tangent_motion(spec, vs, time_s)
             if vs.camera is not None:
                 views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
                                     cam_from_world=world_from_x.inverse(), frame_index=frame,
-                                    view_set=set_index, motion=vs.motion, light_scales=scales))
+                                    view_set=set_index, motion=motion, light_scales=scales,
+                                    time_s=time_s))
             else:
                 rig = spec.rigs[vs.rig]
                 for member in rig.members:
@@ -52,7 +56,8 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
                         cam_from_world=world_from_cam.inverse(), rig=rig.name,
                         rig_member=member.name, frame_index=frame, view_set=set_index,
-                        motion=member_motion(vs.motion, member.rig_from_cam), light_scales=scales))
+                        motion=member_motion(motion, member.rig_from_cam), light_scales=scales,
+                        time_s=time_s))
             frame += 1
     return tuple(views)
 
@@ -77,6 +82,9 @@ def placement_poses(vs: m.ViewSet) -> list[Rigid3]:
     p = vs.placement
     if isinstance(p, m.PoseList):
         return list(p.world_from_cam)
+    if isinstance(p, m.TrajectoryPath):
+        traj = p.trajectory.trajectory()
+        return [traj.pose(t) for t in p.times_s]
     if isinstance(p, m.LookAtList):
         aims = [(e.eye, e.target, e.up) for e in p.entries]
     elif isinstance(p, m.Orbit):
@@ -151,6 +159,25 @@ def random_eyes_targets(p: m.RandomPoses, vs: m.ViewSet | None = None
         eyes.append(eye)
         targets.append(target)
     return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)
+
+
+def _timed(spec: m.SceneSpec, camera: str) -> bool:
+    shutter = getattr(spec.cameras[camera].optics, "shutter", None)
+    return shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
+
+
+def tangent_motion(spec: m.SceneSpec, vs: m.ViewSet, time_s: float):
+    """Within one frame's exposure and readout a camera (or rig frame) on a trajectory moves with
+    the trajectory's tangent at the frame time: its body velocities R^T v, R^T omega (world
+    velocities v, omega of :mod:`scenegen.geometry.trajectory`). None when no camera of the view
+    set has a shutter with an exposure or a readout time (nothing would use it)."""
+    cams = [vs.camera] if vs.camera is not None else [mb.camera for mb in spec.rigs[vs.rig].members]
+    if not any(_timed(spec, c) for c in cams):
+        return None
+    st = vs.placement.trajectory.trajectory().state(time_s)
+    R = st.world_from_frame.R
+    return Motion(linear_velocity_mps=tuple(R.T @ st.linear_velocity_mps),
+                  angular_velocity_deg_s=tuple(np.degrees(R.T @ st.angular_velocity_rad_s)))
 
 
 def member_motion(rig_motion, rig_from_cam: Rigid3):

@@ -12,6 +12,7 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.pfm`: Middlebury/ETH3D float maps.
 * :mod:`.kitti`: KITTI uint16 disparity PNGs.
 * :mod:`.flo`: Middlebury optical flow.
+* :mod:`.tracks`: TAP-Vid-style point tracks as a pickle-free NPZ.
 * :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
 from scenegen.dataset.codecs.dng import DngRaw, decode_dng, encode_dng, read_dng, write_dng
@@ -27,6 +28,7 @@ from scenegen.dataset.codecs.kitti import (
 from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
+from scenegen.dataset.codecs.tracks import TRACK_KEYS, TrackSet, decode_tracks, encode_tracks, read_tracks, write_tracks
 
 __all__ = [
     "DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng",
@@ -35,4 +37,5 @@ __all__ = [
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
     "decode_npy", "encode_npy", "read_npy", "write_npy", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
     "decode_png", "encode_png", "read_png", "write_png",
+    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_tracks", "read_tracks", "write_tracks",
 ]
