@@ -29,12 +29,13 @@ def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tup
     ids = np.asarray(object_ids).reshape(-1)
     out = P.copy()
     present = np.ones(len(P), bool)
-    for oid in np.unique(ids):
-        if int(oid) not in poses_a:
-            continue
-        (wa, _), (wb, pb) = poses_a[int(oid)], poses_b[int(oid)]
-        sel = ids == oid
-        if not wa.allclose(wb, 0.0):
+    for oid, (wa, _) in poses_a.items():
+        wb, pb = poses_b[oid]
+        still = wa.allclose(wb, 0.0)
+        if still and pb:
+            continue  # a static object: its points stay, all present (no pass over the pixels)
+        sel = np.flatnonzero(ids == oid)
+        if not still:
             out[sel] = (wb @ wa.inverse()).apply(P[sel])
         present[sel] = pb
     return out, present

@@ -48,7 +48,9 @@ def place_animated(built, t_s: float) -> None:
     if not built.animated:
         return
     states = built.timeline.states(t_s)
-    params = mi.traverse(built.scene)
+    if built.animated_params is None:  # traversed once: the keys do not change
+        built.animated_params = mi.traverse(built.scene)
+    params = built.animated_params
     for an in built.animated:
         st = states[an.name]
         move = st.world_from_object @ an.world_from_object_0.inverse()

@@ -43,6 +43,7 @@ class LoadedScene:
     timeline: object = None  # scenegen.spec.timeline.Timeline of a sequence, else None
     animated: list = field(default_factory=list)  # objects placed per time (animate.Animated)
     time_s: float | None = None  # the clock time the animated objects are at (None: frame 0)
+    animated_params: object = None  # mi.traverse of the scene, made on the first placement
 
     @property
     def variant(self) -> str:
