@@ -91,3 +91,17 @@ def test_objects_are_rendered_where_the_truth_has_them(rendered):
         img = ds.linear_image(v)
         cube = oid == 2
         assert img[cube][:, 0].mean() > 2 * img[cube][:, 1].mean()
+
+
+def test_the_typed_reader_gives_the_sequence_truth(rendered):
+    ds = Dataset(rendered)
+    seq = ds.sequence
+    assert seq.index.timestamps_s == (0.0, 0.05, 0.1)
+    assert ("cam_0000", "cam_0001", 1) in seq.index.pairs and "cam" in seq.index.streams
+    m = seq.motion("cam_0000", "cam_0001")
+    flo = seq.flow("cam_0000", "cam_0001")
+    ok = np.isfinite(flo[..., 0])
+    assert np.abs(m.flow[ok] - flo[ok]).max() < 1e-4  # u, v stored as float32, .flo the difference
+    poses = seq.object_poses(2)
+    assert poses["late"][1] and np.allclose(poses["cube"][0].t, [0.3, 0, 0.15])
+    assert len(seq.tracks("cam")) == 24
