@@ -28,7 +28,9 @@ from scenegen.dataset.codecs.kitti import (
 from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
-from scenegen.dataset.codecs.tracks import TRACK_KEYS, TrackSet, decode_tracks, encode_tracks, read_tracks, write_tracks
+from scenegen.dataset.codecs.tracks import (
+    TRACK_KEYS, TrackSet, decode_tracks, encode_npz, encode_tracks, read_tracks, write_tracks,
+)
 
 __all__ = [
     "DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng",
@@ -37,5 +39,5 @@ __all__ = [
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
     "decode_npy", "encode_npy", "read_npy", "write_npy", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
     "decode_png", "encode_png", "read_png", "write_png",
-    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_tracks", "read_tracks", "write_tracks",
+    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_npz", "encode_tracks", "read_tracks", "write_tracks",
 ]

@@ -65,15 +65,21 @@ class TrackSet:
         return len(self.query_points)
 
 
-def encode_tracks(tracks: TrackSet) -> bytes:
-    """NPZ bytes (stored, not compressed) of the six arrays of :data:`TRACK_KEYS`."""
+def encode_npz(arrays) -> bytes:
+    """NPZ bytes (stored, not compressed, no pickles, fixed member timestamps) of a mapping
+    name -> array, in its order: what ``np.load(..., allow_pickle=False)`` reads."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as z:
-        for key in TRACK_KEYS:
+        for key, arr in arrays.items():
             member = io.BytesIO()
-            np.lib.format.write_array(member, getattr(tracks, key), allow_pickle=False)
+            np.lib.format.write_array(member, np.asarray(arr), allow_pickle=False)
             z.writestr(zipfile.ZipInfo(f"{key}.npy", date_time=_ZIP_TIME), member.getvalue())
     return buf.getvalue()
+
+
+def encode_tracks(tracks: TrackSet) -> bytes:
+    """NPZ bytes (:func:`encode_npz`) of the six arrays of :data:`TRACK_KEYS`."""
+    return encode_npz({key: getattr(tracks, key) for key in TRACK_KEYS})
 
 
 def decode_tracks(data: bytes) -> TrackSet:

@@ -105,3 +105,22 @@ def test_the_typed_reader_gives_the_sequence_truth(rendered):
     poses = seq.object_poses(2)
     assert poses["late"][1] and np.allclose(poses["cube"][0].t, [0.3, 0, 0.15])
     assert len(seq.tracks("cam")) == 24
+
+
+def test_tapvid_export_holds_the_tracks_in_tapvid_form(rendered, tmp_path):
+    assert main(["export", str(rendered), "--format", "tapvid", "-o", str(tmp_path / "tv")]) == 0
+    ds = Dataset(rendered)
+    tr = ds.sequence.tracks("cam")
+    with np.load(tmp_path / "tv" / "cam.npz", allow_pickle=False) as z:
+        assert sorted(z.files) == ["occluded", "points", "query_points", "video"]
+        assert z["video"].shape == (3, 36, 48, 3) and z["video"].dtype == np.uint8
+        assert np.array_equal(z["video"][1], ds.image("cam_0001"))
+        # TAP-Vid's normalised coordinates: image corner (0, 0), opposite corner (1, 1)
+        assert np.allclose(z["points"] * [48, 36] - 0.5, tr.tracks_xy, atol=1e-4, equal_nan=True)
+        assert np.array_equal(z["occluded"], tr.occluded)
+        q = z["query_points"]
+        assert np.array_equal(q[:, 0], tr.query_points[:, 0])
+        assert np.allclose(q[:, 1] * 36 - 0.5, tr.query_points[:, 1], atol=1e-4)
+    assert main(["export", str(rendered), "--format", "tum", "-o", str(tmp_path / "tum")]) == 0
+    first = (tmp_path / "tum" / "cam.txt").read_text().splitlines()
+    assert "time_s" in first[0] and first[2].startswith("0.050000 ")
