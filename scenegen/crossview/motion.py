@@ -22,6 +22,14 @@ from scenegen.geometry.pose import Rigid3
 Poses = Mapping[int, tuple[Rigid3, bool]]  # object id -> (world_from_object, present)
 
 
+def _apply(T: Rigid3, P: np.ndarray) -> np.ndarray:
+    """``T.apply(P)`` per component (no BLAS thread pool next to Dr.Jit's: 10x faster here)."""
+    out = np.empty_like(P)
+    for i in range(3):
+        out[:, i] = T.R[i, 0] * P[:, 0] + T.R[i, 1] * P[:, 1] + T.R[i, 2] * P[:, 2] + T.t[i]
+    return out
+
+
 def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tuple[np.ndarray, np.ndarray]:
     """((N, 3) float64 points at b, (N,) bool their object exists at b) of points (N, 3) at a on
     objects ``object_ids`` (N,) (0 or unknown: no object, the point stays where it is)."""
@@ -36,7 +44,7 @@ def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tup
             continue  # a static object: its points stay, all present (no pass over the pixels)
         sel = np.flatnonzero(ids == oid)
         if not still:
-            out[sel] = (wb @ wa.inverse()).apply(P[sel])
+            out[sel] = _apply(wb @ wa.inverse(), P[sel])
         present[sel] = pb
     return out, present
 

@@ -45,9 +45,13 @@ class SequenceTruth:
             cam = self.built.cameras[view.camera]
             if rolling_shutter_rows(self.built, view) is None:
                 wfc = view.cam_from_world.inverse()
-                d = camera_rays(cam) @ wfc.R.T
-                rng = np.where(t["valid"], t["range"], np.nan).reshape(-1, 1)
-                P = (wfc.t + rng * d).reshape(cam.height, cam.width, 3)
+                rays, R = camera_rays(cam), wfc.R
+                rng = np.where(t["valid"], t["range"], np.nan).reshape(-1)
+                # per component, without a BLAS call (no thread pool next to Dr.Jit's)
+                P = np.empty((len(rng), 3))
+                for i in range(3):
+                    P[:, i] = wfc.t[i] + rng * (R[i, 0] * rays[:, 0] + R[i, 1] * rays[:, 1] + R[i, 2] * rays[:, 2])
+                P = P.reshape(cam.height, cam.width, 3)
             else:  # per-row poses: the kernel's float32 points
                 P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(np.float64)
             self._frames[view.name] = (P, t["object_id"].copy())
