@@ -130,3 +130,21 @@ def test_a_static_spec_has_no_time_in_its_resolved_form(tmp_path):
     d = spec_to_dict(parse(CAM + "views:\n  - camera: cam\n    look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]\n"
                            "objects:\n  - {name: a, shape: box}\n", tmp_path))
     assert "sequence" not in d and "time_s" not in d["views"][0] and "animation" not in d["objects"][0]
+
+
+def test_variants_of_a_sequence_jitter_the_keyframes(tmp_path):
+    from scenegen.spec.variants import derive_variant
+    s = parse(CAM + SEQ + VIEWS + "variation: {seed: 4, views: {translation_m: 0.05, rotation_deg: 2}}\n", tmp_path)
+    v = derive_variant(s, 1)
+    a, b = resolve_views(s), resolve_views(v)
+    assert [x.time_s for x in b] == [x.time_s for x in a]
+    d = [np.linalg.norm(x.cam_from_world.inverse().t - y.cam_from_world.inverse().t) for x, y in zip(a, b)]
+    assert 0 < max(d) <= 0.05 * 3 ** 0.5 + 1e-9
+
+
+def test_a_moving_object_cannot_have_its_placement_varied(tmp_path):
+    text = (SEQ + "objects:\n  - {name: a, shape: box, visible_s: [0, 1]}\n"
+            "variation: {objects: {a: {position: {min: [0, 0, 0], max: [1, 1, 0]}}}}\n")
+    with pytest.raises(SpecError) as info:
+        parse(text, tmp_path)
+    assert info.value.line == 4 and "moves over the sequence" in info.value.message
