@@ -105,3 +105,33 @@ def test_rendered_dot_moves_by_the_truth_flow(tmp_path, motion):
     print(f"{motion}: centroid moved {moved.round(4)} px, truth flow {truth.round(4)} px, error {error:.4f} px")
     assert np.linalg.norm(truth) > 3  # it does move
     assert error < TOL_CENTROID_PX
+
+
+def test_motion_blur_follows_the_trajectory_within_the_exposure(tmp_path):
+    """With a 40 ms exposure the sliding dot is smeared along its path (8 motion sub-frames on
+    the trajectory), and its centroid stays at the frame time's position: the linear trajectory
+    is symmetric about mid-exposure."""
+    _dot_png(tmp_path / "dot.png")
+    plate = PLATES["slides"].replace("time_s: 0.1,", "time_s: 0.2,")  # 0.4 m/s; frames 0.1 s apart
+    sharp, blurred = (HEAD.replace("fx: 150}", "fx: 150" + s + "}") for s in ("", ", shutter: {exposure_s: 0.04}"))
+    moments = []
+    for name, head in (("sharp", sharp), ("blurred", blurred)):
+        (tmp_path / f"{name}.yaml").write_text(head.replace("frames: 2", "frames: 2, start_s: 0.05") + plate)
+        render_spec(tmp_path / f"{name}.yaml", tmp_path / name, progress=False)
+        ds = Dataset(tmp_path / name)
+        img, mask = ds.linear_image(ds.views[0])[..., 1], ds.truth(ds.views[0])["object_id"] == 1
+        c = _centroid(img, mask, radius_px=14.0)
+        w = np.clip(1.0 - img.astype(np.float64), 0, None)
+        yy, xx = np.mgrid[0:img.shape[0], 0:img.shape[1]]
+        disc = (xx - c[0]) ** 2 + (yy - c[1]) ** 2 <= 14.0 ** 2
+        d = np.stack([xx - c[0], yy - c[1]], -1)[disc]
+        cov = (w[disc][:, None, None] * d[:, :, None] * d[:, None, :]).sum(0) / w[disc].sum()
+        moments.append((c, cov))
+    (c0, cov0), (c1, cov1) = moments
+    streak = np.array([0.4 * 0.04 * 75.0, 0.3 * 0.04 * 75.0])  # image motion over the exposure, px
+    print(f"blurred centroid {c1.round(4)} vs sharp {c0.round(4)}: {np.linalg.norm(c1 - c0):.4f} px; "
+          f"variance along the path +{streak @ (cov1 - cov0) @ streak / (streak @ streak):.3f} px^2 "
+          f"(a uniform smear of {np.linalg.norm(streak):.2f} px adds {np.linalg.norm(streak) ** 2 / 12:.3f})")
+    assert np.linalg.norm(c1 - c0) < TOL_CENTROID_PX
+    u = streak / np.linalg.norm(streak)
+    assert abs(u @ (cov1 - cov0) @ u - np.linalg.norm(streak) ** 2 / 12) < 0.1 * np.linalg.norm(streak) ** 2 / 12
