@@ -11,20 +11,21 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``opencv``: cv2.FileStorage YAML (K, D, R, T per view; K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q per
   stereo frame; R T E F per cross-view pair);
 * ``tum``: TUM RGB-D trajectories, one file per camera stream;
-* ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream.
+* ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream;
+* ``preview``: a GIF and an MP4 per stream of a sequence with its point tracks drawn.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from scenegen.export import colmap, kitti_stereo, middlebury, nerf, opencv_yaml, tapvid, tum
+from scenegen.export import colmap, kitti_stereo, middlebury, nerf, opencv_yaml, preview, tapvid, tum
 from scenegen.export.common import open_dataset, prepare_dest
 from scenegen.export.errors import ExportError
 
 #: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
 FORMATS = {"colmap": colmap.export, "nerf": nerf.export, "kitti-stereo": kitti_stereo.export,
            "middlebury": middlebury.export, "opencv": opencv_yaml.export, "tum": tum.export,
-           "tapvid": tapvid.export}
+           "tapvid": tapvid.export, "preview": preview.export}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

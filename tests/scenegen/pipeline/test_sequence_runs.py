@@ -124,3 +124,24 @@ def test_tapvid_export_holds_the_tracks_in_tapvid_form(rendered, tmp_path):
     assert main(["export", str(rendered), "--format", "tum", "-o", str(tmp_path / "tum")]) == 0
     first = (tmp_path / "tum" / "cam.txt").read_text().splitlines()
     assert "time_s" in first[0] and first[2].startswith("0.050000 ")
+
+
+def test_preview_export_draws_the_tracks(rendered, tmp_path):
+    import cv2
+    from PIL import Image
+
+    from scenegen.export.preview import _colour
+
+    assert main(["export", str(rendered), "--format", "preview", "-o", str(tmp_path / "pv")]) == 0
+    assert sorted(p.name for p in (tmp_path / "pv").iterdir()) == ["cam.gif", "cam.mp4"]
+    ds = Dataset(rendered)
+    tr = ds.sequence.tracks("cam")
+    gif = Image.open(tmp_path / "pv" / "cam.gif")
+    assert gif.n_frames == 3 and gif.size == (48, 36)
+    cap = cv2.VideoCapture(str(tmp_path / "pv" / "cam.mp4"))
+    assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 3 and int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)) == 48
+    gif.seek(2)
+    frame = np.asarray(gif.convert("RGB")).astype(int)
+    n = int(np.flatnonzero(~tr.occluded[:, 2])[-1])  # drawn last: on top
+    x, y = np.rint(tr.tracks_xy[n, 2]).astype(int)
+    assert np.abs(frame[y, x] - _colour(n)).max() < 60  # its dot, in its colour (GIF palette)
