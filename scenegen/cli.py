@@ -21,7 +21,7 @@ EXIT_BAD_INPUT = 2
 #: ``--variant`` choices: scenegen.spec.model.RENDER_VARIANTS (equal, tests/scenegen/test_cli.py)
 RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 #: ``export --format`` choices: scenegen.export.FORMATS (equal, tests/scenegen/test_cli.py)
-EXPORT_FORMATS = ("colmap", "nerf", "kitti-stereo", "middlebury", "opencv", "tum", "tapvid", "preview")
+EXPORT_FORMATS = ("colmap", "nerf", "kitti-stereo", "middlebury", "opencv", "tum", "tapvid", "preview", "kitti-flow")
 
 
 def _err(msg: str) -> int:
@@ -143,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("dataset", type=Path)
     f.add_argument("--json", action="store_true")
     f.set_defaults(fn=cmd_verify)
-    e = sub.add_parser("export", help="export a dataset to colmap, nerf, kitti-stereo, middlebury, opencv, tum, tapvid or preview")
+    e = sub.add_parser("export", help="export a dataset to colmap, nerf, kitti-stereo, middlebury, opencv, tum, tapvid, preview or kitti-flow")
     e.add_argument("dataset", type=Path)
     e.add_argument("--format", required=True, choices=EXPORT_FORMATS)
     e.add_argument("-o", "--output", type=Path, help="destination folder (default: <dataset>.<format>)")

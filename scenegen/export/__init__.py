@@ -12,20 +12,22 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
   stereo frame; R T E F per cross-view pair);
 * ``tum``: TUM RGB-D trajectories, one file per camera stream;
 * ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream;
-* ``preview``: a GIF and an MP4 per stream of a sequence with its point tracks drawn.
+* ``preview``: a GIF and an MP4 per stream of a sequence with its point tracks drawn;
+* ``kitti-flow``: KITTI 2015 flow layout (flow_occ / flow_noc PNGs) from a sequence's flow.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from scenegen.export import colmap, kitti_stereo, middlebury, nerf, opencv_yaml, preview, tapvid, tum
+from scenegen.export import colmap, kitti_flow, kitti_stereo, middlebury, nerf, opencv_yaml, preview, tapvid, tum
 from scenegen.export.common import open_dataset, prepare_dest
 from scenegen.export.errors import ExportError
 
 #: Format name -> its exporter ``export(dataset, dest) -> summary dict``.
 FORMATS = {"colmap": colmap.export, "nerf": nerf.export, "kitti-stereo": kitti_stereo.export,
            "middlebury": middlebury.export, "opencv": opencv_yaml.export, "tum": tum.export,
-           "tapvid": tapvid.export, "preview": preview.export}
+           "tapvid": tapvid.export, "preview": preview.export,
+           "kitti-flow": kitti_flow.export}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

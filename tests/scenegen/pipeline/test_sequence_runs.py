@@ -145,3 +145,22 @@ def test_preview_export_draws_the_tracks(rendered, tmp_path):
     n = int(np.flatnonzero(~tr.occluded[:, 2])[-1])  # drawn last: on top
     x, y = np.rint(tr.tracks_xy[n, 2]).astype(int)
     assert np.abs(frame[y, x] - _colour(n)).max() < 60  # its dot, in its colour (GIF palette)
+
+
+def test_kitti_flow_export_reads_back_with_the_devkit_rule(rendered, tmp_path):
+    import cv2
+
+    from scenegen.dataset.crossview import VISIBLE
+
+    assert main(["export", str(rendered), "--format", "kitti-flow", "-o", str(tmp_path / "k")]) == 0
+    ds = Dataset(rendered)
+    m = ds.sequence.motion("cam_0000", "cam_0001")
+    for kind in ("occ", "noc"):
+        bgr = cv2.imread(str(tmp_path / f"k/training/flow_{kind}/000000_10.png"), cv2.IMREAD_UNCHANGED)
+        rgb = bgr[..., ::-1].astype(np.float64)  # the devkit's readFlowField, independently
+        valid = rgb[..., 2] > 0
+        flow = (rgb[..., :2] - 2 ** 15) / 64.0
+        want = np.isfinite(m.flow[..., 0]) & ((m.state == VISIBLE) if kind == "noc" else True)
+        assert np.array_equal(valid, want)
+        assert np.abs(flow[valid] - m.flow[valid]).max() <= 1 / 64
+    assert (tmp_path / "k/training/image_2/000001_11.png").is_file()
