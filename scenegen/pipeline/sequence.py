@@ -26,7 +26,6 @@ from scenegen.dataset.sequence import (
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.pipeline.pairs import streams
 from scenegen.pipeline.view import rolling_shutter_rows, view_truth
-from scenegen.render.truth import camera_rays
 from scenegen.spec.timeline import Timeline
 
 
@@ -45,7 +44,7 @@ class SequenceTruth:
             cam = self.built.cameras[view.camera]
             if rolling_shutter_rows(self.built, view) is None:
                 wfc = view.cam_from_world.inverse()
-                rays, R = camera_rays(cam), wfc.R
+                rays, R = self.built.camera_rays(cam), wfc.R
                 rng = np.where(t["valid"], t["range"], np.nan).reshape(-1)
                 # per component, without a BLAS call (no thread pool next to Dr.Jit's)
                 P = np.empty((len(rng), 3))

@@ -18,7 +18,7 @@ from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entry
-from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
+from scenegen.render.truth import camera_rays, prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 from scenegen.spec.timeline import Timeline, is_animated
 
@@ -74,6 +74,11 @@ class LoadedScene:
     def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False) -> dict[str, np.ndarray]:
         """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
         return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored)
+
+    def camera_rays(self, camera) -> np.ndarray:
+        """(H*W, 3) float64 unit rays of the camera's pixel centres, row-major, as the truth pass
+        casts them (:func:`scenegen.render.truth.camera_rays`, read-only)."""
+        return camera_rays(camera)
 
     def visible_from(self, center_world, points_world) -> np.ndarray:
         """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""
