@@ -16,6 +16,7 @@ from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.read import read_enum, read_float, read_floats, read_int, read_vec3, seed_or_none
 from scenegen.spec.parse.transforms import POSE_KEYS, parse_pose, parse_rigid
 from scenegen.spec.timeline import object_states
+from scenegen.spec.views import resolve_views
 
 ANIMATION_KEYS = ("trajectory", "parent", "joint", "visible_s")
 #: Largest accepted frame count of a sequence (its views are named with the frame number).
@@ -202,8 +203,25 @@ def _is_sphere(shape: Node) -> bool:
 def check_sequence(f: Fields, spec) -> None:
     """Whole-spec rules of a sequence: the static cross-view truth only without moving objects."""
     moving = [o.name for o in spec.objects if o.animation is not None]
-    if spec.crossview is not None and moving:
-        raise f.get("crossview").error(
-            "the cross-view truth (crossview:) is for a static scene, and objects "
-            f"{', '.join(moving)} move: use the sequence's flow and tracks (sequence.flow_steps, "
-            "sequence.tracks), which move each point with its object")
+    cv = spec.crossview
+    if cv is None or not moving:
+        return
+    hint = (f"objects {', '.join(moving)} move, and the cross-view truth relates views of one time "
+            "only (a rig's members, stereo frames, per-view boards); across time use the "
+            "sequence's flow and tracks (sequence.flow_steps, sequence.tracks)")
+    node = f.get("crossview")
+    cf = node.as_mapping() if node.is_mapping else None
+    if cv.flow:
+        raise (cf.get("flow") if cf is not None and cf.get("flow") is not None else node).error(
+            f"set flow: false: {hint}")
+    if isinstance(cv.pairs, str):
+        if cv.pairs != "none":
+            raise (cf.get("pairs") if cf is not None and cf.get("pairs") is not None else node).error(
+                f"pairs {cv.pairs!r} relates frames of different times; give pairs: none or pairs of "
+                f"the same frame: {hint}")
+        return
+    times = {v.name: v.time_s for v in resolve_views(spec)}
+    for k, (a, b) in enumerate(cv.pairs):
+        if times[a] != times[b]:
+            raise cf.get("pairs").items()[k].error(
+                f"views {a} and {b} are at {times[a]:g} s and {times[b]:g} s: {hint}")

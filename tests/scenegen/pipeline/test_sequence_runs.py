@@ -164,3 +164,89 @@ def test_kitti_flow_export_reads_back_with_the_devkit_rule(rendered, tmp_path):
         assert np.array_equal(valid, want)
         assert np.abs(flow[valid] - m.flow[valid]).max() <= 1 / 64
     assert (tmp_path / "k/training/image_2/000001_11.png").is_file()
+
+
+STEREO_SPEC = """
+name: seqstereo
+render: {spp: 1, max_depth: 2}
+sequence: {fps: 10, frames: 2}
+objects:
+  - name: floor
+    shape: {type: plane, size: [4, 4]}
+  - name: ball
+    shape: {type: sphere, radius: 0.3}
+    trajectory:
+      interpolation: linear
+      keyframes:
+        - {time_s: 0.0, translation: [-0.4, 0, 0.3]}
+        - {time_s: 0.1, translation: [0.4, 0.2, 0.3]}
+lights: [{type: constant, radiance: 1}]
+cameras: {cam: {size: [64, 48], fx: 50}}
+rigs: {st: {type: stereo, left: cam, right: cam, baseline_m: 0.2}}
+views:
+  - rig: st
+    trajectory: {keyframes: [{time_s: 0, eye: [0, -2.5, 1.5], target: [0, 0, 0.2]}]}
+crossview: {pairs: none, flow: false, stereo: true}
+"""
+
+
+def test_stereo_frames_of_a_moving_scene_are_cast_at_their_time(tmp_path):
+    """The rectified disparity of each frame of a moving stereo rig equals f B / Z of an
+    independent analytic cast of the rectified left camera with the ball where it is then."""
+    from scenegen.dataset.codecs import read_pfm
+
+    (tmp_path / "s.yaml").write_text(STEREO_SPEC)
+    assert main(["render", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "o"), "-q"]) == 0
+    ds = Dataset(tmp_path / "o")
+    for k, centre in enumerate(([-0.4, 0, 0.3], [0.4, 0.2, 0.3])):
+        calib = read_json(tmp_path / f"o/crossview/stereo/st_left_{k:04d}/calib.json")
+        K, (W, H) = np.array(calib["K"]), calib["size"]
+        R = np.array(calib["cam_left_from_world"]["R"])
+        t = np.array(calib["cam_left_from_world"]["t"])
+        C = -R.T @ t
+        u, v = np.meshgrid(np.arange(W, dtype=float), np.arange(H, dtype=float))
+        d_cam = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones_like(u)], -1).reshape(-1, 3)
+        d = d_cam @ R  # world directions (not unit): depth along the axis = the ray parameter
+        s_floor = np.where(d[:, 2] < 0, -C[2] / d[:, 2], np.inf)
+        oc = C - np.asarray(centre)
+        a, b, c = np.sum(d * d, 1), 2 * d @ oc, oc @ oc - 0.3 ** 2
+        disc = b * b - 4 * a * c
+        with np.errstate(invalid="ignore"):
+            s_ball = np.where(disc >= 0, (-b - np.sqrt(disc)) / (2 * a), np.inf)
+        z = np.minimum(s_floor, s_ball).reshape(H, W)
+        want = K[0, 0] * 0.2 / z
+        got = read_pfm(tmp_path / f"o/crossview/stereo/st_left_{k:04d}/disp_left.pfm")
+        ball = (s_ball < s_floor).reshape(H, W)
+        ok = np.isfinite(got) & np.isfinite(want)
+        assert ball.sum() > 50 and np.abs(got[ok] - want[ok]).max() < 1e-3, k
+    assert ds.crossview.index.stereo == (("st_left_0000", "st_right_0000"), ("st_left_0001", "st_right_0001"))
+
+
+def test_a_moving_board_has_its_corner_truth_at_each_frame(tmp_path):
+    import cv2
+
+    from scenegen.geometry.pose import Rigid3
+
+    spec = STEREO_SPEC.replace("""  - name: ball
+    shape: {type: sphere, radius: 0.3}""", """  - name: ball
+    target: {type: aruco_grid, markers_x: 2, markers_y: 2, marker_m: 0.2, separation_m: 0.05,
+             dictionary: DICT_4X4_50}""").replace("translation: [-0.4, 0, 0.3]}", "translation: [-0.4, 0, 0.3], "
+                                                  "rotation_deg: [0, 0, 0]}").replace(
+        "translation: [0.4, 0.2, 0.3]}", "translation: [0.4, 0.2, 0.3], rotation_deg: [0, 0, 30]}").replace(
+        "stereo: true}", "stereo: false, targets: true}")
+    (tmp_path / "s.yaml").write_text(spec)
+    assert main(["render", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "o"), "-q"]) == 0
+    ds = Dataset(tmp_path / "o")
+    board = read_json(tmp_path / "o/scene/targets/ball.json")
+    for k in range(2):
+        wfo, _ = ds.sequence.object_poses(k)["ball"]
+        w0, _ = ds.sequence.object_poses(0)["ball"]  # scene/targets/ holds the board at frame 0
+        wfb = wfo @ w0.inverse() @ Rigid3.from_dict(board["world_from_board"])
+        want = wfb.apply(np.array(board["points_board"], float))
+        for member in ("left", "right"):
+            view = f"st_{member}_{k:04d}"
+            truth = read_json(tmp_path / f"o/crossview/targets/{view}.json")["boards"]["ball"]
+            assert np.abs(np.array(truth["points_world"]) - want).max() < 1e-9
+            cam, pose = ds.camera(view)
+            uv, _ = cv2.projectPoints(want, cv2.Rodrigues(pose.R)[0], pose.t, cam.K, np.zeros(5))
+            assert np.abs(np.array(truth["uv"], float) - uv.reshape(-1, 2)).max() < 1e-6

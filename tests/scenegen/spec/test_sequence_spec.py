@@ -112,8 +112,13 @@ ERRORS = [
      "keyframes: [{time_s: 0, angle_deg: 0}]}\n", 5, "objects[0].joint.axis", "non-zero axis"),
     ("joint_key_of_other_type", SEQ + "objects:\n  - name: a\n    shape: box\n    joint: {type: prismatic, axis: [0, 0, 1], "
      "keyframes: [{time_s: 0, angle_deg: 0}]}\n", 5, "objects[0].joint.keyframes[0].angle_deg", "unknown key"),
-    ("crossview_with_moving_objects", CAM + SEQ + "objects:\n  - {name: a, shape: box, visible_s: [0, 1]}\n"
-     + VIEWS + "crossview: {}\n", 12, "crossview", "is for a static scene"),
+    ("crossview_flow_with_moving_objects", CAM + SEQ + "objects:\n  - {name: a, shape: box, visible_s: [0, 1]}\n"
+     + VIEWS + "crossview: {}\n", 12, "crossview", "set flow: false"),
+    ("crossview_pairs_across_time", CAM + SEQ + "objects:\n  - {name: a, shape: box, visible_s: [0, 1]}\n"
+     + VIEWS + "crossview: {flow: false}\n", 12, "crossview", "relates frames of different times"),
+    ("crossview_explicit_pair_across_time", CAM + SEQ + "objects:\n  - {name: a, shape: box, visible_s: [0, 1]}\n"
+     + VIEWS + "crossview:\n  flow: false\n  pairs: [[cam_0000, cam_0001]]\n", 14, "crossview.pairs[0]",
+     "are at 0 s and 0.1 s"),
 ]
 
 
