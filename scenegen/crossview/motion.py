@@ -10,7 +10,7 @@ OCCLUDED wherever it projects into b's image. Scene flow is ``P_b - P_a`` in the
 """
 from __future__ import annotations
 
-from typing import Callable, Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 

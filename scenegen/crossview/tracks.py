@@ -6,8 +6,8 @@ projected by the frame's camera, and its visibility decided by a ray cast in the
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -13,8 +13,8 @@ the per-frame object poses and the index of ``sequence/``.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 

@@ -9,9 +9,7 @@ import numpy as np
 
 from scenegen.dataset.codecs import TrackSet, decode_flo, read_exr, read_json, read_tracks
 from scenegen.dataset.errors import DatasetError
-from scenegen.dataset.layout import (
-    SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path,
-)
+from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
 from scenegen.dataset.sequence import SEQUENCE_FORMAT, SEQUENCE_FORMAT_VERSION, MotionTruth, decode_motion_channels
 from scenegen.geometry.pose import Rigid3
 
@@ -23,7 +21,7 @@ class SequenceIndex:
     streams: dict  # stream name -> its frames (view names, in order)
 
     @classmethod
-    def from_dict(cls, d) -> "SequenceIndex":
+    def from_dict(cls, d) -> SequenceIndex:
         if d.get("format") != SEQUENCE_FORMAT or d.get("format_version") != SEQUENCE_FORMAT_VERSION:
             raise ValueError(f"format: expected {SEQUENCE_FORMAT!r} version {SEQUENCE_FORMAT_VERSION}, got "
                              f"{d.get('format')!r} version {d.get('format_version')!r}")

@@ -10,6 +10,7 @@ image (TAP-Vid's occluded flag; out-of-frame points are not drawn). Colours are 
 from __future__ import annotations
 
 import io
+import itertools
 
 import cv2
 import numpy as np
@@ -42,7 +43,7 @@ def draw_tracks(frames_rgb: np.ndarray, tracks) -> np.ndarray:
                     cv2.circle(img, tuple(int(c) for c in xy[n, t]), 3 << _SHIFT, colour, 1, cv2.LINE_AA, _SHIFT)
                 continue
             seen = [k for k in range(max(0, t - TRAIL_FRAMES), t + 1) if not tracks.occluded[n, k]]
-            for a, b in zip(seen, seen[1:]):
+            for a, b in itertools.pairwise(seen):
                 cv2.line(img, tuple(int(c) for c in xy[n, a]), tuple(int(c) for c in xy[n, b]), colour, 1,
                          cv2.LINE_AA, _SHIFT)
             cv2.circle(img, tuple(int(c) for c in xy[n, t]), 2 << _SHIFT, colour, -1, cv2.LINE_AA, _SHIFT)
@@ -62,7 +63,7 @@ def export(ds, dest) -> dict:
         drawn = draw_tracks(video, ds.sequence.tracks(stream))
         gif = io.BytesIO()
         pics = [Image.fromarray(f) for f in drawn]
-        pics[0].save(gif, format="GIF", save_all=True, append_images=pics[1:], duration=int(round(1000 / fps)),
+        pics[0].save(gif, format="GIF", save_all=True, append_images=pics[1:], duration=round(1000 / fps),
                      loop=0)
         key = name("stream", stream)
         write(dest, f"{key}.gif", gif.getvalue())

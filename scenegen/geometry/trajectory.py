@@ -50,11 +50,11 @@ class MotionState:
     angular_acceleration_rad_s2: np.ndarray  # (3,)
 
     @classmethod
-    def still(cls, pose: Rigid3) -> "MotionState":
+    def still(cls, pose: Rigid3) -> MotionState:
         z = np.zeros(3)
         return cls(pose, z, z.copy(), z.copy(), z.copy())
 
-    def compose(self, child: "MotionState") -> "MotionState":
+    def compose(self, child: MotionState) -> MotionState:
         """The state of ``self.world_from_frame @ child.world_from_frame`` when ``child`` is
         expressed in this frame (its velocities in this frame's axes): the usual rigid-body
         composition, ``omega = omega_p + R_p omega_c``, ``v = v_p + omega_p x r + R_p v_c``

@@ -16,11 +16,12 @@ from scenegen.crossview.motion import moved_correspondence
 from scenegen.crossview.tracks import FrameGeometry, track_points
 from scenegen.dataset.codecs import TrackSet, encode_exr, encode_flo, encode_json, encode_tracks
 from scenegen.dataset.crossview import STATE_NAMES
-from scenegen.dataset.layout import (
-    SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path,
-)
+from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
 from scenegen.dataset.sequence import (
-    SCENE_FLOW_FRAME, SEQUENCE_FORMAT, SEQUENCE_FORMAT_VERSION, encode_motion_channels,
+    SCENE_FLOW_FRAME,
+    SEQUENCE_FORMAT,
+    SEQUENCE_FORMAT_VERSION,
+    encode_motion_channels,
     objects_document,
 )
 from scenegen.geometry.seeds import hashed_seed32

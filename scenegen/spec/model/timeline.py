@@ -5,11 +5,11 @@ settings (docs/scene_spec.md, "Sequences"). The interpolation itself is
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
-from scenegen.geometry.trajectory import INTERPOLATIONS, JOINT_TYPES, KeyframeTrajectory, JointTrajectory
+from scenegen.geometry.trajectory import INTERPOLATIONS, JOINT_TYPES, JointTrajectory, KeyframeTrajectory
 from scenegen.spec.model.meta import SEED_MAX, param, part, where_field
 
 _S = "seconds"

@@ -159,9 +159,8 @@ def parse_animation(f: Fields, node: Node, transform: Transform, ctx: ParseConte
                                     "moves the object, also within the exposure")
     which = f.one_of(("trajectory", "joint"), required=False)
     rest = transform.world_from_object
-    if which == "trajectory":
-        if "transform" in f and not rest.allclose(rest.identity(), 0.0):
-            raise f.get("transform").error("with a trajectory the keyframes place the object: "
+    if which == "trajectory" and "transform" in f and not rest.allclose(rest.identity(), 0.0):
+        raise f.get("transform").error("with a trajectory the keyframes place the object: "
                                            "'transform' may give only 'scale'")
     parent = None
     if "parent" in f:

@@ -153,3 +153,11 @@ def test_a_moving_object_cannot_have_its_placement_varied(tmp_path):
     with pytest.raises(SpecError) as info:
         parse(text, tmp_path)
     assert info.value.line == 4 and "moves over the sequence" in info.value.message
+
+
+def test_a_child_exists_only_while_its_parent_does(tmp_path):
+    text = SEQ + ("objects:\n  - {name: a, shape: box, visible_s: [0.1, 0.2]}\n"
+                  "  - {name: b, shape: box, parent: a, transform: {translation: [0, 0, 1]}}\n")
+    tl = Timeline(parse(text, tmp_path))
+    assert [tl.states(t)["b"].present for t in (0.0, 0.1, 0.2, 0.3)] == [False, True, True, False]
+    assert np.allclose(tl.states(0.0)["b"].world_from_object.t, [0, 0, 1])
