@@ -19,8 +19,9 @@ Interpolations (:data:`INTERPOLATIONS`), both passing through every keyframe:
   body angular velocity is ``J_r(s) ds/dt`` (J_r the right Jacobian of SO(3)) and its angular
   acceleration is differentiated from that in closed form.
 
-Outside ``[t_0, t_last]`` a trajectory holds its end pose (velocities and accelerations 0). A
-single keyframe is a fixed pose. Revolute and prismatic joints (:class:`JointTrajectory`) move a
+Outside ``[t_0, t_last]`` a trajectory holds its end pose (velocities and accelerations 0); at
+``t_0`` and ``t_last`` themselves it has the curve's one-sided derivatives (a frame on the first
+keyframe moves off it within its exposure). A single keyframe is a fixed pose. Revolute and prismatic joints (:class:`JointTrajectory`) move a
 frame about / along a fixed axis with an interpolated scalar (angle or offset).
 """
 from __future__ import annotations
@@ -151,10 +152,10 @@ class KeyframeTrajectory:
         """Pose and world-frame derivatives at ``t_s`` (see the module docstring)."""
         t = float(t_s)
         T = self.times_s
-        if len(T) == 1 or t <= T[0] or t >= T[-1]:
-            return MotionState.still(self.poses[0] if len(T) == 1 or t <= T[0] else self.poses[-1])
+        if len(T) == 1 or t < T[0] or t > T[-1]:
+            return MotionState.still(self.poses[0] if len(T) == 1 or t < T[0] else self.poses[-1])
         if self.interpolation == "linear":
-            k = int(np.searchsorted(T, t, side="right")) - 1
+            k = min(int(np.searchsorted(T, t, side="right")) - 1, len(T) - 2)
             dt = T[k + 1] - T[k]
             u = (t - T[k]) / dt
             w_body = rotvec_from_matrix(self._R[k].T @ self._R[k + 1])
@@ -196,11 +197,11 @@ class JointTrajectory:
 
     def _q_derivatives(self, t: float) -> tuple[float, float, float]:
         T, q = self.times_s, self.values
-        if len(T) == 1 or t <= T[0] or t >= T[-1]:
-            return (float(q[0]) if len(T) == 1 or t <= T[0] else float(q[-1])), 0.0, 0.0
+        if len(T) == 1 or t < T[0] or t > T[-1]:
+            return (float(q[0]) if len(T) == 1 or t < T[0] else float(q[-1])), 0.0, 0.0
         if self._q is not None:
             return float(self._q(t)), float(self._q(t, 1)), float(self._q(t, 2))
-        k = int(np.searchsorted(T, t, side="right")) - 1
+        k = min(int(np.searchsorted(T, t, side="right")) - 1, len(T) - 2)
         rate = (q[k + 1] - q[k]) / (T[k + 1] - T[k])
         return float(q[k] + rate * (t - T[k])), float(rate), 0.0
 

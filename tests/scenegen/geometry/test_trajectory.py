@@ -138,3 +138,15 @@ def test_compose_matches_finite_differences():
         assert np.abs(st.linear_acceleration_mps2 - la).max() < 1e-5
         assert np.abs(st.angular_acceleration_rad_s2 - aa).max() < 1e-5
     assert isinstance(MotionState.still(Rigid3.identity()), MotionState)
+
+
+@pytest.mark.parametrize("interp", ["linear", "spline"])
+def test_the_end_keyframes_have_the_one_sided_derivatives(interp):
+    tr = KeyframeTrajectory(TIMES, _poses(7), interp)
+    h = 1e-6
+    v0 = (tr.pose(TIMES[0] + h).t - tr.pose(TIMES[0]).t) / h
+    v1 = (tr.pose(TIMES[-1]).t - tr.pose(TIMES[-1] - h).t) / h
+    assert np.abs(tr.state(TIMES[0]).linear_velocity_mps - v0).max() < 1e-4
+    assert np.abs(tr.state(TIMES[-1]).linear_velocity_mps - v1).max() < 1e-4
+    assert np.linalg.norm(v0) > 0.1
+    assert not tr.state(TIMES[-1] + 1e-9).linear_velocity_mps.any()
