@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.geometry.color import srgb_image
-from scenegen.geometry.optics import motion_to_dict, row_poses
+from scenegen.geometry.optics import PathMotion, motion_to_dict, row_poses
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.imaging.stage import apply_imaging
 
@@ -57,7 +57,9 @@ def view_optics(built, view) -> dict | None:
     """What cameras.json records of a view's lens and time effects (None if it has none)."""
     optics = built.optics.get(view.camera)
     d = optics.to_dict() if optics is not None else {}
-    if view.motion is not None and not view.motion.is_static:
+    if isinstance(view.motion, PathMotion):  # a sequence's camera: its trajectory within the frame
+        d["camera_motion"] = motion_to_dict(view.motion)
+    elif view.motion is not None and not view.motion.is_static:
         d["camera_motion"] = {**motion_to_dict(view.motion), "frame": "camera (OpenCV axes), body velocities; "
                               "world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau], tau from mid-exposure"}
     ca = getattr(optics, "chromatic_aberration", None)

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from scenegen.errors import SpecError
-from scenegen.geometry.optics import Motion
+from scenegen.geometry.optics import Motion, PathMotion
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
 
@@ -42,7 +42,7 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
         times = vs.placement.times_s if isinstance(vs.placement, m.TrajectoryPath) else None
         for k, world_from_x in enumerate(poses):
             time_s = None if times is None else float(times[k])
-            motion = vs.motion if times is None else tangent_motion(spec, vs, time_s)
+            motion = vs.motion if times is None else path_motion(spec, vs, time_s)
             if vs.camera is not None:
                 views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
                                     cam_from_world=world_from_x.inverse(), frame_index=frame,
@@ -166,18 +166,15 @@ def _timed(spec: m.SceneSpec, camera: str) -> bool:
     return shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
 
 
-def tangent_motion(spec: m.SceneSpec, vs: m.ViewSet, time_s: float):
-    """Within one frame's exposure and readout a camera (or rig frame) on a trajectory moves with
-    the trajectory's tangent at the frame time: its body velocities R^T v, R^T omega (world
-    velocities v, omega of :mod:`scenegen.geometry.trajectory`). None when no camera of the view
-    set has a shutter with an exposure or a readout time (nothing would use it)."""
+def path_motion(spec: m.SceneSpec, vs: m.ViewSet, time_s: float):
+    """Within one frame's exposure and readout a camera (or rig frame) on a trajectory moves along
+    the trajectory itself (:class:`scenegen.geometry.optics.PathMotion`; the renderer and the
+    per-row truth sample the same curve). None when no camera of the view set has a shutter with
+    an exposure or a readout time (nothing would use it)."""
     cams = [vs.camera] if vs.camera is not None else [mb.camera for mb in spec.rigs[vs.rig].members]
     if not any(_timed(spec, c) for c in cams):
         return None
-    st = vs.placement.trajectory.trajectory().state(time_s)
-    R = st.world_from_frame.R
-    return Motion(linear_velocity_mps=tuple(R.T @ st.linear_velocity_mps),
-                  angular_velocity_deg_s=tuple(np.degrees(R.T @ st.angular_velocity_rad_s)))
+    return PathMotion(trajectory=vs.placement.trajectory.trajectory(), time_s=float(time_s))
 
 
 def member_motion(rig_motion, rig_from_cam: Rigid3):
@@ -185,6 +182,8 @@ def member_motion(rig_motion, rig_from_cam: Rigid3):
     v_cam = R^T (v + omega x t), with rig_from_cam = (R, t)."""
     if rig_motion is None:
         return None
+    if isinstance(rig_motion, PathMotion):  # the member on the rig's path
+        return PathMotion(trajectory=rig_motion.trajectory, time_s=rig_motion.time_s, x_from_cam=rig_from_cam)
     R, t = rig_from_cam.R, rig_from_cam.t
     w = np.radians(np.asarray(rig_motion.angular_velocity_deg_s, dtype=np.float64))
     v = np.asarray(rig_motion.linear_velocity_mps, dtype=np.float64)

@@ -39,7 +39,7 @@ def parse_view_set(node: Node, index: int, ctx: ParseContext) -> mv.ViewSet:
                                 "a 'trajectory' (one view per frame of the clock)")
     if kind == "trajectory" and "motion" in f:
         raise f.get("motion").error("'motion' cannot be combined with a trajectory: within the "
-                                    "exposure the camera follows the trajectory's tangent")
+                                    "exposure the camera follows the trajectory itself")
     parse = {"orbit": parse_orbit, "look_at": parse_look_at_list, "poses": parse_poses,
              "random": parse_random, "path": parse_path, "trajectory": parse_trajectory_path}[kind]
     placement = parse(f.get(kind), "rig" if rig else "cam", ctx)
