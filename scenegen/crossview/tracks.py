@@ -26,17 +26,21 @@ class FrameGeometry:
     visible_fn: Callable[[np.ndarray, np.ndarray], np.ndarray]  # in this frame's scene
 
 
-def track_points(points_world, object_ids, poses_query: Poses, frames: list[FrameGeometry]):
-    """((N, T, 2) float64 pixels, (N, T) bool occluded, (N, T) bool out of frame) of surface points
-    (N, 3) (world, at their query frame, on objects (N,)) over the frames. Occluded: not VISIBLE
-    (out of frame, behind another surface, or the object absent), as TAP-Vid counts it."""
-    P = np.asarray(points_world, np.float64).reshape(-1, 3)
-    n, t = len(P), len(frames)
+def track_points(groups, frames: list[FrameGeometry]):
+    """((N, T, 2) float64 pixels, (N, T) bool occluded, (N, T) bool out of frame) of surface
+    points over the frames. ``groups``: [(points (n, 3) world at their query frame, object ids
+    (n,), poses at the query frame)], concatenated in order (N = the sum of the n); each frame
+    is cast once for all of them. Occluded: not VISIBLE (out of frame, behind another surface,
+    or the object absent), as TAP-Vid counts it."""
+    groups = [(np.asarray(P, np.float64).reshape(-1, 3), np.asarray(ids).reshape(-1), poses) for P, ids, poses in groups]
+    n, t = sum(len(g[0]) for g in groups), len(frames)
     xy = np.full((n, t, 2), np.nan)
     occ = np.ones((n, t), bool)
     oof = np.ones((n, t), bool)
     for k, fr in enumerate(frames):
-        Pk, present = move_points(P, object_ids, poses_query, fr.poses)
+        moved = [move_points(P, ids, poses, fr.poses) for P, ids, poses in groups]
+        Pk = np.concatenate([m[0] for m in moved]) if moved else np.zeros((0, 3))
+        present = np.concatenate([m[1] for m in moved]) if moved else np.zeros(0, bool)
         c = correspond(Pk.reshape(n, 1, 3), fr.camera, fr.cam_from_world, fr.visible_fn)
         state = c.state.reshape(n)
         xy[:, k] = c.uv.reshape(n, 2)

@@ -10,6 +10,8 @@ written when every view is complete.
 """
 from __future__ import annotations
 
+from collections import OrderedDict
+
 import numpy as np
 
 from scenegen.crossview.motion import moved_correspondence
@@ -33,10 +35,11 @@ from scenegen.spec.timeline import Timeline
 class SequenceTruth:
     """Truth of a sequence's frames: float64 points, object ids, poses, visibility at a time."""
 
-    def __init__(self, spec, built):
+    def __init__(self, spec, built, keep_frames: int = 8):
         self.spec, self.built = spec, built
         self.timeline = Timeline(spec)
-        self._frames: dict = {}
+        self._frames: OrderedDict = OrderedDict()  # the last keep_frames frames' points (bounded memory)
+        self.keep_frames = max(2, int(keep_frames))
 
     def frame(self, view) -> tuple[np.ndarray, np.ndarray]:
         """((H, W, 3) float64 world points, NaN = no surface; (H, W) uint32 object ids) of a view."""
@@ -55,6 +58,9 @@ class SequenceTruth:
             else:  # per-row poses: the kernel's float32 points
                 P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(np.float64)
             self._frames[view.name] = (P, t["object_id"].copy())
+            while len(self._frames) > self.keep_frames:
+                self._frames.popitem(last=False)
+        self._frames.move_to_end(view.name)
         return self._frames[view.name]
 
     def poses(self, view):
@@ -97,17 +103,16 @@ def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
               for v in vs]
     animated = {o.object_id for o in st.spec.objects if o.animation is not None}
     qs = [q for q in cfg.query_frames if q < len(vs)]
-    queries, xys, occs, oofs = [], [], [], []
+    queries, groups = [], []
     for i, q in enumerate(qs):
         P, ids = st.frame(vs[q])
         n = cfg.count // len(qs) + (1 if i < cfg.count % len(qs) else 0)
         px = query_pixels(ids, np.isfinite(P[..., 0]), animated, n, hashed_seed32(cfg.seed, name, q))
-        xy, occ, oof = track_points(P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.poses(vs[q]), frames)
+        groups.append((P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.poses(vs[q])))
         queries.append(np.column_stack([np.full(len(px), q), px[:, 1], px[:, 0]]))
-        xys.append(xy), occs.append(occ), oofs.append(oof)
+    xy, occ, oof = track_points(groups, frames)  # each frame's scene cast once for every query
     cam = st.built.cameras[vs[0].camera]
-    return TrackSet(query_points=np.concatenate(queries), tracks_xy=np.concatenate(xys),
-                    occluded=np.concatenate(occs), out_of_frame=np.concatenate(oofs),
+    return TrackSet(query_points=np.concatenate(queries), tracks_xy=xy, occluded=occ, out_of_frame=oof,
                     image_size=np.array([cam.width, cam.height]), frame_names=np.array([v.name for v in vs]))
 
 
@@ -116,7 +121,8 @@ def run_sequence(spec, views, built, writer) -> dict | None:
     seq = getattr(spec, "sequence", None)
     if seq is None:
         return None
-    st = SequenceTruth(spec, built)
+    # frames a step away on both sides stay cached while the targets are walked in order
+    st = SequenceTruth(spec, built, keep_frames=2 * max(seq.flow_steps) + 2)
     done = [v for v in views if writer.is_complete(v.name)]
     names = {v.name for v in done}
     files: list[str] = []
@@ -133,15 +139,17 @@ def run_sequence(spec, views, built, writer) -> dict | None:
              "state_codes": {str(k): v for k, v in STATE_NAMES.items()}, "pairs": [], "tracks": []}
     for (set_index, member), vs in streams(views).items():
         name = stream_name(spec.view_sets[set_index].prefix, member)
+        jobs = []  # (position of the target frame, source, target): one scene move per target
         for step in seq.flow_steps:
-            for a, b in zip(vs, vs[step:]):
+            for k, (a, b) in enumerate(zip(vs, vs[step:])):
                 if a.name not in names or b.name not in names:
                     continue
-                for i, j in ((a, b), (b, a)):
-                    m = st.motion(i, j)
-                    write(motion_path(i.name, j.name), encode_exr(encode_motion_channels(m)))
-                    write(sequence_flow_path(i.name, j.name), encode_flo(m.flow))
+                jobs += [(k + step, a, b), (k, b, a)]
                 index["pairs"].append({"a": a.name, "b": b.name, "step": step})
+        for _, i, j in sorted(jobs, key=lambda job: job[0]):
+            m = st.motion(i, j)
+            write(motion_path(i.name, j.name), encode_exr(encode_motion_channels(m)))
+            write(sequence_flow_path(i.name, j.name), encode_flo(m.flow))
         if seq.tracks is not None and all(v.name in names for v in vs):
             write(tracks_path(name), encode_tracks(stream_tracks(st, vs, name, seq.tracks)))
             index["tracks"].append({"stream": name, "frames": [v.name for v in vs]})
