@@ -61,7 +61,6 @@ def test_sensor_rays_follow_the_trajectory(sensor):
     d_cam = CAM.unproject_unit(np.stack([u, v], 1))
     worst_d = worst_o = worst_tangent = 0.0
     w = TRAJ.state(TIME_S)
-    R = mid.R
     for i in range(n):
         exact = motion.world_from_cam(tau[i])
         worst_d = max(worst_d, np.linalg.norm(d[i] - exact.rotate(d_cam[i])))
