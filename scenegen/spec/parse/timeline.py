@@ -15,7 +15,7 @@ from scenegen.spec.model.meta import WORLD_UP
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.read import read_enum, read_float, read_floats, read_int, read_vec3, seed_or_none
 from scenegen.spec.parse.transforms import POSE_KEYS, parse_pose, parse_rigid
-from scenegen.spec.timeline import object_states
+from scenegen.spec.timeline import local_trajectory, object_states
 from scenegen.spec.views import resolve_views
 
 ANIMATION_KEYS = ("trajectory", "parent", "joint", "visible_s")
@@ -185,11 +185,10 @@ def parse_animation(f: Fields, node: Node, transform: Transform, ctx: ParseConte
         trajectory=parse_trajectory(f.get("trajectory"), "object") if which == "trajectory" else None,
         joint=parse_joint(f.get("joint")) if which == "joint" else None, visible_s=visible)
     t0 = ctx.sequence.timestamps_s[0]
-
-    class _Probe:  # this object, for the parent chain's state at frame 0
-        name, animation = "\0probe", anim
-    states = object_states(tuple(ctx.objects) + (_Probe,), t0)
-    return anim, Transform(world_from_object=states[_Probe.name].world_from_object, scale=transform.scale)
+    pose = local_trajectory(anim).state(t0).world_from_frame  # parent_from_object at frame 0
+    if parent is not None:
+        pose = object_states(ctx.objects, t0)[parent].world_from_object @ pose
+    return anim, Transform(world_from_object=pose, scale=transform.scale)
 
 
 def _is_sphere(shape: Node) -> bool:
