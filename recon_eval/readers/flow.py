@@ -18,34 +18,14 @@ import numpy as np
 
 from recon_eval.errors import InputError
 from scenegen.dataset.codecs import decode_flo, encode_png, read_npy, read_pfm, read_png
+from scenegen.dataset.codecs.kitti_flow import (  # the format lives with the dataset codecs
+    KITTI_FLOW_OFFSET, KITTI_FLOW_SCALE, decode_kitti_flow, encode_kitti_flow,
+)
 from scenegen.dataset.files import atomic_write_bytes
 
 FLOW_SUFFIXES = (".flo", ".png", ".npy", ".pfm")
-KITTI_FLOW_SCALE = 64.0
-KITTI_FLOW_OFFSET = 32768.0
-
-
-def decode_kitti_flow(img: np.ndarray) -> np.ndarray:
-    """(H, W, 2) float64 flow (NaN invalid) of a KITTI flow PNG's (H, W, 3) uint16 RGB values."""
-    if img.dtype != np.uint16 or img.ndim != 3 or img.shape[2] != 3:
-        raise ValueError(f"KITTI flow PNGs are 16-bit RGB, got {img.dtype} {img.shape}")
-    f = (img[..., :2].astype(np.float64) - KITTI_FLOW_OFFSET) / KITTI_FLOW_SCALE
-    f[img[..., 2] == 0] = np.nan
-    return f
-
-
-def encode_kitti_flow(flow) -> np.ndarray:
-    """(H, W, 3) uint16 RGB of a flow (NaN = invalid), as the devkit's ``writeFlowField``:
-    ``max(min(f * 64 + 32768, 65535), 0)`` in float32 (the devkit's float), truncated, blue 1 where
-    valid."""
-    f = np.asarray(flow, np.float64)
-    valid = np.all(np.isfinite(f), axis=2)
-    out = np.zeros(f.shape[:2] + (3,), np.uint16)
-    f32 = np.where(valid[..., None], f, 0.0).astype(np.float32)
-    q = np.clip(f32 * np.float32(KITTI_FLOW_SCALE) + np.float32(KITTI_FLOW_OFFSET), np.float32(0), np.float32(65535))
-    out[..., :2] = np.where(valid[..., None], q, 0).astype(np.uint16)
-    out[..., 2] = valid
-    return out
+__all__ = ["FLOW_SUFFIXES", "KITTI_FLOW_OFFSET", "KITTI_FLOW_SCALE", "decode_kitti_flow", "encode_kitti_flow",
+           "read_flow", "write_kitti_flow"]
 
 
 def write_kitti_flow(path, flow) -> None:

@@ -6,7 +6,7 @@ Layout::
     {"format": "scenegen-dataset", "format_version": 1, "view_order": [view, ...],
      "views": {view: {"camera": Camera.to_dict(), "cam_from_world": {"R": 3x3, "t": 3},
                       "camera_name", "rig", "rig_member", "frame_index",
-                      ["view_set"], ["lights"], ["optics"], ["raw"]}},
+                      ["view_set"], ["lights"], ["optics"], ["raw"], ["time_s"]}},
      "spec": the resolved spec dict (scenegen.spec.serialize.spec_to_dict)}
 """
 from __future__ import annotations
@@ -40,6 +40,8 @@ class ViewCamera:
     # used for this view (0 = off); None (older datasets) = not recorded
     raw: Mapping[str, Any] | None = None  # the raw output's record (scenegen.dataset.raw), None
     # for a view without raw files
+    time_s: float | None = None  # seconds on the sequence clock (a sequence frame); None = a
+    # static scene
 
     def to_dict(self) -> dict:
         cam = self.camera.to_dict() if hasattr(self.camera, "to_dict") else dict(self.camera)
@@ -55,6 +57,8 @@ class ViewCamera:
             d["optics"] = dict(self.optics)
         if self.raw is not None:
             d["raw"] = dict(self.raw)
+        if self.time_s is not None:
+            d["time_s"] = float(self.time_s)
         return d
 
 

@@ -23,6 +23,11 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     crossview/matches/<i>/<j>_<kind>.npy    labelled putative matches (kind: synthetic, sift)
     crossview/targets/<view>.json           per-view calibration-target truth
     crossview/stereo/<left view>/<file>     rectified pair: STEREO_FILES
+    sequence/index.json                     what the sequence stage wrote (pairs, tracks)
+    sequence/objects.json                   every object's world_from_object, presence, velocities per frame
+    sequence/motion/<a>/<b>.exr             flow, scene flow, depth in b, occlusion state of a's pixels at b
+    sequence/flow/<a>/<b>.flo               optical flow a -> b (moving objects moved)
+    sequence/tracks/<stream>.npz            TAP-Vid-style point tracks of a camera stream
 
 Every name that becomes part of a path is checked here (:func:`check_name`): names read from a
 spec or from a dataset's own JSON never reach the file system unchecked.
@@ -204,3 +209,24 @@ def stereo_path(left_view: str, key: str, side: str | None = None) -> str:
         raise ValueError(f"stereo file: key one of {list(STEREO_FILES)} or 'calib', side one of {STEREO_SIDES};"
                          f" got {key!r}, {side!r}")
     return f"{stereo_dir(left_view)}/{STEREO_FILES[key].format(side=side)}"
+
+
+# --- sequences (moving scenes) -----------------------------------------------------------------
+SEQUENCE = "sequence"
+SEQUENCE_INDEX = f"{SEQUENCE}/index.json"
+SEQUENCE_OBJECTS = f"{SEQUENCE}/objects.json"
+
+
+def motion_path(a: str, b: str) -> str:
+    """Flow, scene flow, depth and state of view a's pixels at view b (EXR)."""
+    return f"{SEQUENCE}/motion/{check_view_name(a)}/{check_view_name(b)}.exr"
+
+
+def sequence_flow_path(a: str, b: str) -> str:
+    """Optical flow a -> b of a sequence, Middlebury .flo."""
+    return f"{SEQUENCE}/flow/{check_view_name(a)}/{check_view_name(b)}.flo"
+
+
+def tracks_path(stream: str) -> str:
+    """Point tracks of a camera stream (view set prefix, with the rig member), NPZ."""
+    return f"{SEQUENCE}/tracks/{check_name('stream', stream)}.npz"

@@ -41,6 +41,7 @@ from scenegen.dataset.layout import (
 from scenegen.dataset.journal import load_current_manifest
 from scenegen.dataset.manifest import STATUS_COMPLETE
 from scenegen.dataset.raw import RawImage, raw_image
+from scenegen.dataset.sequence_reader import SequenceTruth
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
@@ -272,6 +273,12 @@ class Dataset:
         if self._crossview is None:
             self._crossview = CrossviewTruth(self)
         return self._crossview
+
+    # --- sequence truth
+    @property
+    def sequence(self) -> SequenceTruth:
+        """The truth across time of a sequence (docs/crossview.md, "Sequences")."""
+        return SequenceTruth(self)
 
 
 def _check_names(source: str, *, views=(), paths=(), names=()) -> None:

@@ -13,23 +13,30 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
   stereo frame; R T E F per cross-view pair);
 * ``tum``: TUM RGB-D trajectories and per stream rgb/, depth/ (x5000), rgb.txt, depth.txt,
   groundtruth.txt, associations.txt.
+* ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream;
+* ``tracks-video``: a GIF and an MP4 per stream of a sequence with its point tracks drawn;
+* ``kitti-flow``: KITTI 2015 flow layout (flow_occ / flow_noc PNGs) from a sequence's flow.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from scenegen.export import colmap, gaussian_splatting, kitti_stereo, middlebury, nerf, opencv_yaml, tum
+from scenegen.export import (
+    colmap, gaussian_splatting, kitti_flow, kitti_stereo, middlebury, nerf, opencv_yaml, tapvid, tracks_video, tum,
+)
 from scenegen.export.common import open_dataset, staged_dest
 from scenegen.export.errors import ExportError
 
 #: Format name -> its exporter ``export(dataset, dest, progress=None) -> summary dict``
-#: (``progress(done, total)`` after each view, stereo frame or reference view).
+#: (``progress(done, total)`` after each view, stereo frame, reference view or stream).
 FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
-           "tum": tum.export}
+           "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
+           "kitti-flow": kitti_flow.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
-                  "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views"}
+                  "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
+                  "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

@@ -6,7 +6,8 @@ A stream is the views of one camera name, rig and rig member, in frame order; it
 
 * ``<stream>.txt``: each line is the camera's pose in the world (world_from_cam: t = camera
   centre, q = its rotation, scalar LAST as TUM writes it), OpenCV camera axes, metres.
-  Timestamp = frame_index (seconds, ``%.6f``; the dataset has no clock). Quaternions come from
+  Timestamp = the view's time on a sequence's clock (``time_s``, seconds, ``%.6f``), or, for a
+  static scene (no clock), its frame_index. Quaternions come from
   :func:`scenegen.geometry.rotation.quat_wxyz_from_matrix`.
 * ``<stream>/``: ``rgb/<timestamp>.png`` (8-bit RGB), ``depth/<timestamp>.png`` (uint16 z-depth
   times 5000, TUM's factor: 5000 = 1 m; 0 = no surface or beyond 13.107 m), ``rgb.txt`` and
@@ -22,7 +23,7 @@ from scenegen.geometry.color import to_uint8
 from scenegen.geometry.rotation import quat_wxyz_from_matrix
 
 DEPTH_UNITS_PER_M = 5000.0
-TRAJECTORY_HEAD = "# scenegen truth: timestamp (= frame index) tx ty tz qx qy qz qw, world_from_cam, OpenCV camera axes"
+TRAJECTORY_HEAD = "# scenegen truth: timestamp (= {what}) tx ty tz qx qy qz qw, world_from_cam, OpenCV camera axes"
 
 
 def _list(kind: str, rows) -> bytes:
@@ -34,11 +35,12 @@ def export(ds, dest, progress=None) -> dict:
     for v in ds.views:
         info = ds.view_info(v)
         key = name("stream", f"{info['rig']}_{info['rig_member']}" if info.get("rig") else info["camera_name"])
-        streams.setdefault(key, []).append((info["frame_index"], v))
+        streams.setdefault(key, []).append((info.get("time_s", info["frame_index"]), v))
     n, too_far = 0, 0
     done = 0
     for key, items in streams.items():
-        lines, rgb, depth = [TRAJECTORY_HEAD], [], []
+        what = "time_s" if "time_s" in ds.view_info(items[0][1]) else "frame index"
+        lines, rgb, depth = [TRAJECTORY_HEAD.format(what=what)], [], []
         for frame, v in sorted(items):
             _, pose = ds.camera(v)
             wfc = pose.inverse()

@@ -11,7 +11,7 @@ row v (OpenCV pixel row, 0 = top) is exposed around ``row_time_s(v)``; the middl
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -71,6 +71,30 @@ class Motion:
         """The displacement after ``tau_s`` seconds: rotation exp(omega tau), translation v tau."""
         R = matrix_from_rotvec(self.angular_velocity_rad_s * tau_s)
         return Rigid3(R, np.asarray(self.linear_velocity_mps, dtype=np.float64) * tau_s)
+
+
+@dataclass(frozen=True, eq=False)
+class PathMotion:
+    """A camera (or a rig member) moving along a trajectory within its frame, exactly: the pose
+    ``tau_s`` seconds after the frame time is ``trajectory.pose(time_s + tau_s) @ x_from_cam``
+    (x = the trajectory's frame: the camera, or the rig). Used like :class:`Motion` (``delta``,
+    :func:`cam_from_world_at`, :func:`row_poses`); the renderer's sensor samples it as a table."""
+
+    trajectory: object  # anything with .pose(t) -> Rigid3 world_from_x (geometry.trajectory)
+    time_s: float  # the frame's time on the clock (tau = 0)
+    x_from_cam: Rigid3 = field(default_factory=Rigid3.identity)
+
+    @property
+    def is_static(self) -> bool:
+        return False
+
+    def world_from_cam(self, tau_s: float) -> Rigid3:
+        return self.trajectory.pose(self.time_s + float(tau_s)) @ self.x_from_cam
+
+    def delta(self, tau_s: float) -> Rigid3:
+        """The displacement after ``tau_s`` seconds in the camera's own frame at the frame time:
+        world_from_cam(tau) = world_from_cam(0) @ delta(tau)."""
+        return self.world_from_cam(0.0).inverse() @ self.world_from_cam(tau_s)
 
 
 def cam_from_world_at(cam_from_world_mid: Rigid3, motion: Motion | None, tau_s: float) -> Rigid3:
@@ -141,6 +165,10 @@ class Optics:
 def motion_to_dict(motion: Motion | None) -> dict | None:
     if motion is None:
         return None
+    if isinstance(motion, PathMotion):
+        return {"path": "the view set's trajectory, exactly: world_from_cam(tau) = "
+                        "world_from_x(time_s + tau) @ x_from_cam", "time_s": float(motion.time_s),
+                "x_from_cam": motion.x_from_cam.to_dict()}
     return {"linear_velocity_mps": list(motion.linear_velocity_mps),
             "angular_velocity_deg_s": list(motion.angular_velocity_deg_s)}
 

@@ -5,7 +5,8 @@ Only views that are complete in the dataset take part (a ``--frames`` run covers
 has). Each view's truth points are recomputed in float64 by the truth pass (one ray cast per
 pixel, milliseconds; the same call as the stored truth), so resumed runs give the same bytes.
 Views are projected into each other with their mid-exposure poses (the scene is at
-mid-exposure, as for the truth): for a moving camera with a rolling shutter, i's points follow
+mid-exposure, as for the truth; a sequence's objects at the views' time, which validation makes
+the same for both views of a pair when objects move): for a moving camera with a rolling shutter, i's points follow
 its per-row poses but j is projected as a global shutter at its mid-exposure pose.
 """
 from __future__ import annotations
@@ -82,10 +83,23 @@ class _Context:
             self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
         return self._points[name]
 
+    def at(self, name) -> None:
+        """Move a sequence's objects to the view's time (a static scene: nothing to do)."""
+        self.built.set_time(getattr(self.views[name], "time_s", None))
+
+    def object_pose(self, obj, name):
+        """world_from_object of a spec object when view ``name`` was taken."""
+        tl, t = self.built.timeline, getattr(self.views[name], "time_s", None)
+        if tl is None or t is None or obj.name not in tl.animated:
+            return obj.transform.world_from_object
+        return tl.states(t)[obj.name].world_from_object
+
     def corr(self, i, j) -> Correspondence:
         if (i, j) not in self._corr:
             cam_j, pose_j = self.camera(j)
-            self._corr[(i, j)] = correspond(self.points(i), cam_j, pose_j, self.built.visible_from)
+            points = self.points(i)
+            self.at(j)  # j's scene casts the visibility (the same time as i's: checked at validation)
+            self._corr[(i, j)] = correspond(points, cam_j, pose_j, self.built.visible_from)
         return self._corr[(i, j)]
 
     def write(self, rel: str, data: bytes) -> None:
@@ -102,7 +116,7 @@ def _homographies(ctx: _Context, i: str, j: str) -> dict:
     for obj in ctx.spec.objects:
         if obj.geometry.kind not in PLANAR_KINDS:
             continue
-        wfo = obj.transform.world_from_object
+        wfo = ctx.object_pose(obj, i)
         n_i, d_i = plane_in_camera(pose_i, wfo.R[:, 2], wfo.t)  # object z = 0 plane, normal +z
         if abs(d_i) < 1e-12:
             continue  # camera i lies in the plane: no homography
@@ -134,7 +148,9 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
         root = ctx.writer.root
         pi, pj = sift_matches(read_png(root / view_paths(a)["image"]), read_png(root / view_paths(b)["image"]),
                               cfg.sift_ratio)
+        ctx.at(a)
         P = ctx.built.surface_points(cam_a, pose_a, pi)
+        ctx.at(b)
         c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
         rows = label_real_matches(pi, pj, c.uv.reshape(-1, 2), c.state.ravel() == VISIBLE, cfg.sift_inlier_px)
         ctx.write(matches_path(a, b, "sift"), encode_npy(rows))
@@ -183,10 +199,15 @@ def run_crossview(spec, views, built, writer, *, spp: int, seed: int,
         for left, right in stereo:
             index["stereo"].append(write_stereo_frame(ctx, left, right, spp=spp, seed=seed))
             bar.advance()
+        objects = {o.name: o for o in spec.objects}
         for v in targets:
             cam, pose = ctx.camera(v.name)
-            boards = {name: board_view_truth(board, wfb, cam, pose, built.visible_from)
-                      for name, (board, wfb) in built.boards.items()}
+            ctx.at(v.name)
+            boards = {}
+            for name, (board, wfb) in built.boards.items():  # a moving board: moved with its object
+                obj = objects[name]
+                wfb_v = ctx.object_pose(obj, v.name) @ obj.transform.world_from_object.inverse() @ wfb
+                boards[name] = board_view_truth(board, wfb_v, cam, pose, built.visible_from)
             ctx.write(view_targets_path(v.name), encode_json({"view": v.name, "boards": boards}))
             index["targets"].append(v.name)
             bar.advance()

@@ -19,6 +19,7 @@ from scenegen.imaging.stage import imaging_record, raw_view_record
 from scenegen.pipeline.crossview import run_crossview
 from scenegen.pipeline.distributed import render_views_dask
 from scenegen.pipeline.progress import ViewProgress
+from scenegen.pipeline.sequence import run_sequence
 from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
@@ -111,7 +112,8 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                                        frame_index=v.frame_index, optics=view_optics(built, v),
                                        view_set=spec.view_sets[v.view_set].prefix,
                                        lights=light_scales_dict(spec, v.light_scales),
-                                       raw=raw_view_record(spec.cameras[v.camera].imaging, v.name))
+                                       raw=raw_view_record(spec.cameras[v.camera].imaging, v.name),
+                                       time_s=v.time_s)
                  for v in views}  # all views, whatever --frames selects: cameras.json is the same for every run
     resolved = spec_to_dict(spec)
     resolved["render_used"] = dict(used.__dict__)
@@ -144,5 +146,6 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
                     rendered += 1
                     bar.advance()
     run_crossview(spec, views, built, writer, spp=spp, seed=seed, progress=progress)  # docs/crossview.md
+    run_sequence(spec, views, built, writer)  # truth across time of a sequence (docs/crossview.md)
     writer.close()
     return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)

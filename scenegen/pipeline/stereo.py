@@ -35,6 +35,7 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
     rc = rect.camera
     built = ctx.built
     view_l = ctx.views[left]
+    ctx.at(left)  # a sequence's objects at the frame's time (both members share it)
     truths = {}
     for side, pose in zip(STEREO_SIDES, (rect.cam_left_from_world, rect.cam_right_from_world)):
         lin = built.render_ideal(view_l.camera, rc, pose, spp=spp, seed=hashed_seed32(seed, left, side),

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.geometry.color import srgb_image
-from scenegen.geometry.optics import motion_to_dict, row_poses
+from scenegen.geometry.optics import PathMotion, motion_to_dict, row_poses
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.imaging.stage import apply_imaging
 
@@ -29,7 +29,9 @@ def rolling_shutter_rows(built, view):
 
 def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
     """The truth pass of a view: per-row poses for a rolling shutter; range and depth_z in
-    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``."""
+    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``.
+    A sequence's frame is cast at its time (the scene's objects moved there)."""
+    built.set_time(getattr(view, "time_s", None))
     return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view),
                        as_stored=as_stored)
 
@@ -37,6 +39,7 @@ def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
     :func:`scenegen.dataset.writer.encode_view`; ``index`` is the view's position in the run."""
+    built.set_time(getattr(v, "time_s", None))  # a sequence's frame: its objects at its time
     linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
                           light_scales=v.light_scales)
     truth = view_truth(built, v, as_stored=True)
@@ -54,7 +57,9 @@ def view_optics(built, view) -> dict | None:
     """What cameras.json records of a view's lens and time effects (None if it has none)."""
     optics = built.optics.get(view.camera)
     d = optics.to_dict() if optics is not None else {}
-    if view.motion is not None and not view.motion.is_static:
+    if isinstance(view.motion, PathMotion):  # a sequence's camera: its trajectory within the frame
+        d["camera_motion"] = motion_to_dict(view.motion)
+    elif view.motion is not None and not view.motion.is_static:
         d["camera_motion"] = {**motion_to_dict(view.motion), "frame": "camera (OpenCV axes), body velocities; "
                               "world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau], tau from mid-exposure"}
     ca = getattr(optics, "chromatic_aberration", None)

@@ -7,6 +7,7 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.lights import set_lighting
+from scenegen.render.animate import place_animated
 from scenegen.render.objects import place_moving_objects
 from scenegen.spec.model.render import effective_spp
 
@@ -36,7 +37,10 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
     out = np.zeros((camera.height, camera.width, 3), np.float64)
     for k in range(n_sub):
         if n_sub > 1:
-            place_moving_objects(built, ((k + 0.5) / n_sub - 0.5) * exposure)
+            tau = ((k + 0.5) / n_sub - 0.5) * exposure
+            place_moving_objects(built, tau)
+            if built.animated:  # a sequence's objects follow their trajectories within the exposure
+                place_animated(built, built.time_s + tau)
         for c, cam in enumerate(channel_cameras):
             sensor.set_camera(cam, cam_from_world, optics, motion, time_window=(k / n_sub, (k + 1) / n_sub))
             img = np.array(mi.render(built.scene, sensor=sensor, spp=sub_spp, seed=(int(seed) + k) % 2**32),
@@ -47,6 +51,8 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
                 out += img
     if n_sub > 1:
         place_moving_objects(built, 0.0)
+        if built.animated:
+            place_animated(built, built.time_s)
     return (out / n_sub).astype(np.float32)
 
 

@@ -14,12 +14,14 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast, sensor as sensor_mod
+from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entries
-from scenegen.render.truth import prepare_camera, shape_id_table, truth_pass
+from scenegen.render.truth import camera_rays, prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 from scenegen.spec.assets_check import located
+from scenegen.spec.timeline import Timeline, is_animated
 
 
 @dataclass
@@ -43,6 +45,10 @@ class LoadedScene:
     # of a mesh rendered with its own materials
     alpha_masked: bool = False  # some surface has an alpha mask: truth rays test its opacity
     sampler: str = "ldsampler"  # the sensors' Mitsuba sampler plugin (it rounds spp up: effective_spp)
+    timeline: object = None  # scenegen.spec.timeline.Timeline of a sequence, else None
+    animated: list = field(default_factory=list)  # objects placed per time (animate.Animated)
+    time_s: float | None = None  # the clock time the animated objects are at (None: frame 0)
+    animated_params: object = None  # mi.traverse of the scene, made on the first placement
 
     @property
     def variant(self) -> str:
@@ -50,6 +56,14 @@ class LoadedScene:
         return mi.variant()
 
     # --- the door: everything the pipeline asks of Mitsuba
+    def set_time(self, t_s: float | None) -> None:
+        """Move the sequence's objects to time ``t_s`` of the clock (renders, truth and
+        visibility casts then see them there); None or a static scene: nothing to do."""
+        if t_s is None or not self.animated or self.time_s == float(t_s):
+            return
+        place_animated(self, float(t_s))
+        self.time_s = float(t_s)
+
     def render(self, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int, motion=None,
                light_scales=None) -> np.ndarray:
         """Linear float32 (H, W, 3) of a view (:func:`scenegen.render.frames.render_view`)."""
@@ -66,6 +80,11 @@ class LoadedScene:
         """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
         return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored,
                           alpha_masked=self.alpha_masked)
+
+    def camera_rays(self, camera) -> np.ndarray:
+        """(H*W, 3) float64 unit rays of the camera's pixel centres, row-major, as the truth pass
+        casts them (:func:`scenegen.render.truth.camera_rays`, read-only)."""
+        return camera_rays(camera)
 
     def visible_from(self, center_world, points_world) -> np.ndarray:
         """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""
@@ -92,15 +111,20 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
             entries = object_entries(obj, object_key(obj), built)
         d.update(entries)
         for key, entry in entries.items():
+            mesh = built.part_meshes.get(key, built.meshes_world[obj.name])
             if obj.motion is not None and not obj.motion.is_static:
-                built.moving.append(moving_entry(key, obj, entry, built.part_meshes.get(key, built.meshes_world[obj.name])))
+                built.moving.append(moving_entry(key, obj, entry, mesh))
+            if is_animated(obj):
+                built.animated.append(animated_entry(key, obj, entry, mesh))
             object_ids[key] = obj.object_id
             instance_ids[key] = obj.instance_id
         built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
                               "kind": type(obj.geometry).__name__.lower()})
     for i, light in enumerate(spec.lights):
         d[light_key(i)] = light_entry(light)
-    built.motion_subframes = spec.render.motion_subframes if built.moving else 1
+    if built.animated:
+        built.timeline = Timeline(spec)
+    built.motion_subframes = spec.render.motion_subframes if built.moving or built.animated else 1
     for name, cam_spec in spec.cameras.items():
         cam = cam_spec.to_camera()
         built.cameras[name] = cam
@@ -113,6 +137,9 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
     built.light_scales = (1.0,) * len(spec.lights)
     built.sensors = {s.camera_name: s for s in built.scene.sensors()}
     built.id_tables = shape_id_table(built.scene, object_ids, instance_ids)
+    if built.animated:  # at frame 0, where the geometry was placed, hiding what is absent then
+        built.time_s = float(spec.sequence.timestamps_s[0])
+        place_animated(built, built.time_s)
     for cam in built.cameras.values():
         prepare_camera(cam)  # the truth pass's ray table, made here rather than in frame 0
     return built

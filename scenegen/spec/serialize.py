@@ -94,7 +94,8 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         objects.append(d)
     views = [{"name": v.name, "camera": v.camera, "rig": v.rig, "rig_member": v.rig_member,
               "frame_index": v.frame_index, "view_set": v.view_set,
-              "cam_from_world": v.cam_from_world.to_dict()} for v in resolve_views(spec)]
+              "cam_from_world": v.cam_from_world.to_dict(),
+              **({"time_s": v.time_s} if v.time_s is not None else {})} for v in resolve_views(spec)]
     return {
         "format": SPEC_DICT_FORMAT,
         "name": spec.name,
@@ -113,6 +114,7 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         # likewise the cross-view outputs: their settings are part of the run's identity
         **({"crossview": _plain(spec.crossview)} if getattr(spec, "crossview", None) is not None else {}),
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
+        **({"sequence": _plain(spec.sequence)} if getattr(spec, "sequence", None) is not None else {}),
     }
 
 

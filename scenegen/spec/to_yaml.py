@@ -11,6 +11,7 @@ code and names the field of a bad value (``<python>: objects[0].shape.radius: ex
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -113,6 +114,49 @@ def _object(obj: m.SceneObject, materials) -> dict:
     d["instance_id"] = obj.instance_id
     if obj.motion is not None:
         d["motion"] = _motion(obj.motion)
+    if obj.animation is not None:
+        d.update(_animation(obj.animation, _v(obj.transform.scale)))
+        if obj.animation.trajectory is not None:  # the keyframes place it; `transform` scales only
+            d["transform"] = {"scale": _v(obj.transform.scale)}
+    return d
+
+
+def _pose_rows(pose) -> list:
+    return [[float(v) for v in row] for row in pose.matrix]
+
+
+def _trajectory(t: m.TrajectorySpec, frame: str) -> dict:
+    """Keyframes as 4x4 rows (bit-exact): ``matrix`` for an object, ``world_from_<frame>`` else."""
+    key = "matrix" if frame == "object" else f"world_from_{frame}"
+    return {"interpolation": t.interpolation,
+            "keyframes": [{"time_s": k.time_s, key: _pose_rows(k.pose)} for k in t.keyframes]}
+
+
+def _animation(a: m.Animation, scale) -> dict:
+    d: dict[str, Any] = {}
+    if a.parent is not None:
+        d["parent"] = a.parent
+    if a.trajectory is not None:
+        d["trajectory"] = _trajectory(a.trajectory, "object")
+    else:  # a joint or a fixed part: `transform` is its rest placement in the parent frame
+        d["transform"] = {"matrix": _pose_rows(a.rest), "scale": scale}
+    if a.joint is not None:
+        j = a.joint
+        key = "angle_deg" if j.type == "revolute" else "offset_m"
+        d["joint"] = {"type": j.type, "axis": _v(j.axis), "origin": _v(j.origin), "interpolation": j.interpolation,
+                      "keyframes": [{"time_s": k.time_s, key: math.degrees(k.value) if j.type == "revolute"
+                                     else k.value} for k in j.keyframes]}
+    if a.visible_s is not None:
+        d["visible_s"] = _v(a.visible_s)
+    return d
+
+
+def _sequence(q: m.SequenceSpec) -> dict:
+    d: dict[str, Any] = ({"fps": q.fps, "frames": q.frames, "start_s": q.start_s} if q.fps is not None
+                         else {"timestamps_s": _v(q.timestamps_s)})
+    d["flow_steps"] = _v(q.flow_steps)
+    if q.tracks is not None:
+        d["tracks"] = _fields(q.tracks, ("count", "query_frames", "seed"))
     return d
 
 
@@ -192,6 +236,8 @@ def _placement(p, frame: str) -> tuple[str, Any]:
                           "eye_box": {"min": _v(p.eye_min), "max": _v(p.eye_max)},
                           "target_box": {"min": _v(p.target_min), "max": _v(p.target_max)},
                           "up": _v(p.up), "min_distance_m": p.min_distance_m}
+    if isinstance(p, m.TrajectoryPath):
+        return "trajectory", _trajectory(p.trajectory, frame)
     if isinstance(p, m.LinePath):
         return "path", {"line": {"from": _v(p.start), "to": _v(p.end)}, "count": p.count,
                         "target": _v(p.target), "up": _v(p.up)}
@@ -257,6 +303,8 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     d: dict[str, Any] = {"name": spec.name, "description": spec.description, "seed": spec.seed,
                          "render": _fields(spec.render, [f.name for f in dataclasses.fields(spec.render)
                                                          if f.name != "where"])}
+    if spec.sequence is not None:
+        d["sequence"] = _sequence(spec.sequence)
     if spec.materials:
         d["materials"] = {k: _material(v) for k, v in spec.materials.items()}
     if spec.objects:

@@ -139,6 +139,9 @@ def _jitter_views(spec: m.SceneSpec, pj, seed: int, index: int, drawn: list) -> 
     """Each view set's placements as an explicit pose list, each pose offset in its own frame."""
     out = []
     for k, vs in enumerate(spec.view_sets):
+        if isinstance(vs.placement, m.TrajectoryPath):  # a sequence: the keyframes are jittered
+            out.append(_jitter_trajectory(vs, pj, seed, index, k, drawn))
+            continue
         poses = []
         for j, world_from_x in enumerate(placement_poses(vs)):
             rng = _rng(seed, index, f"variation.views.{k}.{j}")
@@ -152,6 +155,23 @@ def _jitter_views(spec: m.SceneSpec, pj, seed: int, index: int, drawn: list) -> 
                           "rotation_axis": axis.tolist(), "rotation_deg": angle_deg})
         out.append(dataclasses.replace(vs, placement=m.PoseList(world_from_cam=tuple(poses))))
     return tuple(out)
+
+
+def _jitter_trajectory(vs, pj, seed: int, index: int, k: int, drawn: list):
+    """A trajectory view set with each keyframe offset in its own frame (as placements are)."""
+    traj = vs.placement.trajectory
+    keys = []
+    for j, kf in enumerate(traj.keyframes):
+        rng = _rng(seed, index, f"variation.views.{k}.keyframes.{j}")
+        t = _uniform(rng, [-pj.translation_m] * 3, [pj.translation_m] * 3)
+        axis = rng.normal(size=3)
+        axis /= max(np.linalg.norm(axis), 1e-300)
+        angle_deg = float(rng.random() * pj.rotation_deg)
+        keys.append(dataclasses.replace(kf, pose=kf.pose @ Rigid3.from_rotvec(axis * math.radians(angle_deg), t)))
+        drawn.append({"view_set": k, "keyframe": j, "translation_m": t.tolist(),
+                      "rotation_axis": axis.tolist(), "rotation_deg": angle_deg})
+    path = dataclasses.replace(vs.placement, trajectory=dataclasses.replace(traj, keyframes=tuple(keys)))
+    return dataclasses.replace(vs, placement=path)
 
 
 def derive_variant(spec: m.SceneSpec, index: int, seed: int | None = None) -> m.SceneSpec:

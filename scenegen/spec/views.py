@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from scenegen.errors import SpecError
-from scenegen.geometry.optics import Motion
+from scenegen.geometry.optics import Motion, PathMotion
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
 
@@ -39,11 +39,15 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
     frame = 0
     for set_index, (vs, poses) in enumerate(zip(spec.view_sets, per_set)):
         scales = view_set_light_scales(spec, vs)
-        for world_from_x in poses:
+        times = vs.placement.times_s if isinstance(vs.placement, m.TrajectoryPath) else None
+        for k, world_from_x in enumerate(poses):
+            time_s = None if times is None else float(times[k])
+            motion = vs.motion if times is None else path_motion(spec, vs, time_s)
             if vs.camera is not None:
                 views.append(m.View(name=f"{vs.prefix}_{frame:0{width}d}", camera=vs.camera,
                                     cam_from_world=world_from_x.inverse(), frame_index=frame,
-                                    view_set=set_index, motion=vs.motion, light_scales=scales))
+                                    view_set=set_index, motion=motion, light_scales=scales,
+                                    time_s=time_s))
             else:
                 rig = spec.rigs[vs.rig]
                 for member in rig.members:
@@ -52,7 +56,8 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
                         cam_from_world=world_from_cam.inverse(), rig=rig.name,
                         rig_member=member.name, frame_index=frame, view_set=set_index,
-                        motion=member_motion(vs.motion, member.rig_from_cam), light_scales=scales))
+                        motion=member_motion(motion, member.rig_from_cam), light_scales=scales,
+                        time_s=time_s))
             frame += 1
     return tuple(views)
 
@@ -77,6 +82,9 @@ def placement_poses(vs: m.ViewSet) -> list[Rigid3]:
     p = vs.placement
     if isinstance(p, m.PoseList):
         return list(p.world_from_cam)
+    if isinstance(p, m.TrajectoryPath):
+        traj = p.trajectory.trajectory()
+        return [traj.pose(t) for t in p.times_s]
     if isinstance(p, m.LookAtList):
         aims = [(e.eye, e.target, e.up) for e in p.entries]
     elif isinstance(p, m.Orbit):
@@ -153,11 +161,29 @@ def random_eyes_targets(p: m.RandomPoses, vs: m.ViewSet | None = None
     return np.array(eyes).reshape(-1, 3), np.array(targets).reshape(-1, 3)
 
 
+def _timed(spec: m.SceneSpec, camera: str) -> bool:
+    shutter = getattr(spec.cameras[camera].optics, "shutter", None)
+    return shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
+
+
+def path_motion(spec: m.SceneSpec, vs: m.ViewSet, time_s: float):
+    """Within one frame's exposure and readout a camera (or rig frame) on a trajectory moves along
+    the trajectory itself (:class:`scenegen.geometry.optics.PathMotion`; the renderer and the
+    per-row truth sample the same curve). None when no camera of the view set has a shutter with
+    an exposure or a readout time (nothing would use it)."""
+    cams = [vs.camera] if vs.camera is not None else [mb.camera for mb in spec.rigs[vs.rig].members]
+    if not any(_timed(spec, c) for c in cams):
+        return None
+    return PathMotion(trajectory=vs.placement.trajectory.trajectory(), time_s=float(time_s))
+
+
 def member_motion(rig_motion, rig_from_cam: Rigid3):
     """A rig's body velocities seen by one member camera: omega_cam = R^T omega,
     v_cam = R^T (v + omega x t), with rig_from_cam = (R, t)."""
     if rig_motion is None:
         return None
+    if isinstance(rig_motion, PathMotion):  # the member on the rig's path
+        return PathMotion(trajectory=rig_motion.trajectory, time_s=rig_motion.time_s, x_from_cam=rig_from_cam)
     R, t = rig_from_cam.R, rig_from_cam.t
     w = np.radians(np.asarray(rig_motion.angular_velocity_deg_s, dtype=np.float64))
     v = np.asarray(rig_motion.linear_velocity_mps, dtype=np.float64)

@@ -10,8 +10,9 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.exr`: named float32/uint32 channels; vectors as ``<prefix>.<component>``.
 * :mod:`.npy`: arrays without pickles.
 * :mod:`.pfm`: Middlebury/ETH3D float maps.
-* :mod:`.kitti`: KITTI uint16 disparity PNGs.
+* :mod:`.kitti`: KITTI uint16 disparity PNGs; :mod:`.kitti_flow`: KITTI 16-bit RGB flow PNGs.
 * :mod:`.flo`: Middlebury optical flow.
+* :mod:`.tracks`: TAP-Vid-style point tracks as a pickle-free NPZ.
 * :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
 from scenegen.dataset.codecs.dng import DngRaw, decode_dng, encode_dng, read_dng, write_dng
@@ -24,15 +25,21 @@ from scenegen.dataset.codecs.kitti import (
                                          encode_kitti_disparity,
                                          kitti_disparity_array,
 )
+from scenegen.dataset.codecs.kitti_flow import decode_kitti_flow_png, encode_kitti_flow_png
 from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
+from scenegen.dataset.codecs.tracks import (
+    TRACK_KEYS, TrackSet, decode_tracks, encode_npz, encode_tracks, read_tracks, write_tracks,
+)
 
 __all__ = [
     "DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng",
     "decode_exr", "encode_exr", "pack_channels", "read_exr", "unpack_channels", "write_exr",
     "decode_flo", "encode_flo", "decode_json", "encode_json", "read_json", "write_json",
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
+    "decode_kitti_flow_png", "encode_kitti_flow_png",
     "decode_npy", "encode_npy", "read_npy", "write_npy", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
     "decode_png", "encode_png", "read_png", "write_png",
+    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_npz", "encode_tracks", "read_tracks", "write_tracks",
 ]

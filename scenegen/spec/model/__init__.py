@@ -21,7 +21,7 @@ Camera models are the registry's (:data:`scenegen.geometry.camera.MODELS`), bit 
 Modules, by idea: :mod:`.meta` (field metadata), :mod:`.render`, :mod:`.materials`,
 :mod:`.geometry` (shapes, meshes, targets, transforms, objects), :mod:`.lights`, :mod:`.cameras`
 (cameras, rigs), :mod:`.views` (view sets, views), :mod:`.crossview`, :mod:`.variation`,
-:mod:`.scene` (SceneSpec). This package re-exports them all.
+:mod:`.timeline` (sequence clock, trajectories, joints, tracks), :mod:`.scene` (SceneSpec). This package re-exports them all.
 """
 from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
 from scenegen.spec.model.crossview import CROSSVIEW_PAIR_MODES, CrossviewSpec, MatchSetSpec
@@ -44,12 +44,15 @@ from scenegen.spec.model.meta import (
 )
 from scenegen.spec.model.render import RENDER_VARIANTS, SAMPLERS, RenderSettings, effective_spp
 from scenegen.spec.model.scene import SceneSpec
+from scenegen.spec.model.timeline import (
+    Animation, JointKeyframe, JointSpec, Keyframe, SequenceSpec, TrackSpec, TrajectorySpec,
+)
 from scenegen.spec.model.variation import (
     CameraVariation, LightVariation, ObjectVariation, PoseJitter, VariationSpec,
 )
 from scenegen.spec.model.views import (
-    CirclePath, LinePath, LookAt, LookAtList, Orbit, Placement, PoseList, RandomPoses, View,
-    ViewSet,
+    CirclePath, LinePath, LookAt, LookAtList, Orbit, Placement, PoseList, RandomPoses,
+    TrajectoryPath, View, ViewSet,
 )
 
 __all__ = [
@@ -68,7 +71,9 @@ __all__ = [
     "spec_fields",
     "RENDER_VARIANTS", "SAMPLERS", "RenderSettings", "effective_spp",
     "SceneSpec",
+    "Animation", "JointKeyframe", "JointSpec", "Keyframe", "SequenceSpec", "TrackSpec",
+    "TrajectorySpec",
     "CameraVariation", "LightVariation", "ObjectVariation", "PoseJitter", "VariationSpec",
     "CirclePath", "LinePath", "LookAt", "LookAtList", "Orbit", "Placement", "PoseList",
-    "RandomPoses", "View", "ViewSet",
+    "RandomPoses", "TrajectoryPath", "View", "ViewSet",
 ]

@@ -181,4 +181,8 @@ class SceneObject:
                              "id")  # may be shared between objects
     motion: Any = part(None, unit="scenegen.geometry.optics.Motion in the world, about the "
                                   "object origin; None = static")
+    animation: Any = part(None, unit="scenegen.spec.model.timeline.Animation over the sequence "
+                                     "(trajectory, parent, joint, visible_s); None = static. With "
+                                     "one, `transform` is the object's pose at frame 0",
+                          omit_default=True)
     where: Where | None = where_field()

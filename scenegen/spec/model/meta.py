@@ -91,7 +91,7 @@ def param(default: Any = MISSING, *, unit: str, label: str | None = None, lo=Non
 def part(default: Any = MISSING, *, unit: str, default_factory: Any = MISSING,
          omit_default: bool = False):
     """A dataclass field holding a nested record, a section or a resolved value (``unit`` says
-    what it holds); absent means its default."""
+    what it holds); absent means its default. ``omit_default``: as for :func:`param`."""
     return field(default=default, default_factory=default_factory,
                  metadata={META_KEY: Meta(unit=unit, part=True, omit_default=omit_default)})
 

@@ -37,6 +37,8 @@ class SceneSpec:
     crossview: CrossviewSpec | None = part(None, unit="cross-view truth to write; None = none")
     variation: VariationSpec | None = part(None, unit="seeded ranges for `scenegen render "
                                                       "--variants N`; None = none declared")
+    sequence: Any = part(None, unit="scenegen.spec.model.timeline.SequenceSpec: the clock of a "
+                                    "sequence; None = a static scene")
     variant: Mapping[str, Any] | None = part(None, unit="a derived variant's index, seed and "
                                                         "drawn values "
                                                         "(scenegen.spec.variants.derive_variant); "

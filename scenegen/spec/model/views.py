@@ -85,7 +85,16 @@ class CirclePath:
     kind: str = field(default="circle", init=False)
 
 
-Placement = Union[Orbit, LookAtList, PoseList, RandomPoses, LinePath, CirclePath]
+@dataclass(frozen=True, kw_only=True, eq=False)
+class TrajectoryPath:
+    """A camera (or rig frame) following keyframes over a sequence: one placement per frame."""
+
+    trajectory: Any  # scenegen.spec.model.timeline.TrajectorySpec of world_from_cam / world_from_rig
+    times_s: tuple[float, ...] = part(unit="seconds: the sequence's timestamps, one view per time")
+    kind: str = field(default="trajectory", init=False)
+
+
+Placement = Union[Orbit, LookAtList, PoseList, RandomPoses, LinePath, CirclePath, TrajectoryPath]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -123,3 +132,5 @@ class View:
     light_scales: tuple[float, ...] | None = part(None, unit="factor on each spec light's power "
                                                   "(spec order; 0 = off); None = every light at "
                                                   "its spec power")
+    time_s: float | None = part(None, unit="seconds on the sequence clock (a sequence frame); "
+                                           "None = a static scene")

@@ -38,6 +38,7 @@ class ParseContext:
     rigs: Mapping[str, Rig] = field(default_factory=frozen_mapping)
     objects: tuple[SceneObject, ...] = ()
     lights: tuple[Light, ...] = ()
+    sequence: object = None  # scenegen.spec.model.timeline.SequenceSpec, set after `sequence:`
 
     def but(self, **changes) -> "ParseContext":
         """A copy with some sections known (the warnings list is shared)."""

@@ -14,6 +14,7 @@ from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
 from scenegen.spec.parse.read import read_bool, read_enum, read_float, read_floats, read_int, seed_or_none
+from scenegen.spec.parse.timeline import ANIMATION_KEYS, parse_animation
 from scenegen.spec.parse.transforms import parse_transform
 
 #: The keys of each shape type, besides `type`.
@@ -29,7 +30,8 @@ SHAPE_CLASSES = {"plane": mg.Plane, "box": mg.Box, "sphere": mg.Sphere, "cylinde
 def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
     f = node.as_mapping("an object (a mapping with 'name' and one of shape, mesh, target)")
     f.check(required=("name",),
-            optional=("shape", "mesh", "target", "transform", "material", "instance_id", "motion"))
+            optional=("shape", "mesh", "target", "transform", "material", "instance_id", "motion")
+            + ANIMATION_KEYS)
     name = f.get("name").as_name("an object name")
     which = f.one_of(("shape", "mesh", "target"))
     if which == "shape":
@@ -39,13 +41,14 @@ def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
     else:
         geometry = parse_target(f.get("target"))
     transform = parse_transform(f.get("transform")) if "transform" in f else mg.Transform()
+    animation, transform = parse_animation(f, node, transform, ctx)
     material = object_material(f.get("material"), node, ctx.materials, ctx)
     object_id = index + 1
     instance_id = read_int(f, mg.SceneObject, "instance_id", default=object_id)
     return mg.SceneObject(name=name, geometry=geometry, transform=transform, material=material,
                           object_id=object_id, instance_id=instance_id,
                           motion=parse_motion(f.get("motion")) if "motion" in f else None,
-                          where=node.where)
+                          animation=animation, where=node.where)
 
 
 def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:

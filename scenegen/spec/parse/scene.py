@@ -20,12 +20,13 @@ from scenegen.spec.parse.objects import parse_object
 from scenegen.spec.parse.read import read_int
 from scenegen.spec.parse.render import parse_render
 from scenegen.spec.parse.rigs import parse_rig
+from scenegen.spec.parse.timeline import check_sequence, parse_sequence
 from scenegen.spec.parse.variation import parse_variation
 from scenegen.spec.parse.views import parse_view_set
 from scenegen.spec.views import resolve_views
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview", "variation")
+                  "cameras", "rigs", "views", "crossview", "variation", "sequence")
 #: Scene name of spec text that comes from no file.
 TEXT_SCENE_NAME = "scene"
 
@@ -49,7 +50,11 @@ def parse_document(doc: Document) -> SceneSpec:
     ctx = ctx.but(materials=frozen_mapping(named_section(f, "materials", parse_material, ctx)))
     ctx = ctx.but(cameras=frozen_mapping(named_section(f, "cameras", parse_camera, ctx)))
     ctx = ctx.but(rigs=frozen_mapping(named_section(f, "rigs", parse_rig, ctx)))
-    objects = list_section(f, "objects", parse_object, ctx)
+    sequence = parse_sequence(f.get("sequence"), ctx) if "sequence" in f else None
+    ctx = ctx.but(sequence=sequence)
+    objects = []  # one by one: a parent is named before its children
+    for i, item in enumerate(f.get("objects").items("a list of objects") if "objects" in f else []):
+        objects.append(parse_object(item, i, ctx.but(objects=tuple(objects))))
     unique_names(f.get("objects"), objects, "object")
     ctx = ctx.but(objects=tuple(objects))
     lights = list_section(f, "lights", parse_light, ctx)
@@ -64,8 +69,10 @@ def parse_document(doc: Document) -> SceneSpec:
         name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
         rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
-        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation)
+        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence)
     views = resolve_views(spec)  # degenerate placements are errors now, not at render time
+    if sequence is not None:
+        check_sequence(f, spec)
     check_pair_views(pair_views, views)
     return spec
 
@@ -106,7 +113,7 @@ def planned_views(vs) -> int:
     """How many views a view set makes (rig members counted), without making them."""
     p = vs.placement
     n = {"orbit": lambda: p.count * len(p.elevations_deg), "look_at": lambda: len(p.entries),
-         "poses": lambda: len(p.world_from_cam)}.get(p.kind, lambda: p.count)()
+         "poses": lambda: len(p.world_from_cam), "trajectory": lambda: len(p.times_s)}.get(p.kind, lambda: p.count)()
     return n
 
 

@@ -79,6 +79,11 @@ def parse_object_variation(name: str, vn: Node, ctx: ParseContext) -> mv.ObjectV
     of = vn.as_mapping("an object variation (position, yaw_deg, color, reseed)")
     of.check(optional=("position", "yaw_deg", "color", "reseed"))
     obj = next(o for o in ctx.objects if o.name == name)
+    moving = [k for k in ("position", "yaw_deg") if k in of and getattr(obj, "animation", None) is not None]
+    if moving:
+        raise of.get(moving[0]).error(f"object {name!r} moves over the sequence (trajectory, parent, "
+                                      f"joint or visible_s): its placement comes from there, so "
+                                      f"{moving[0]!r} cannot vary it")
     pos = parse_box(of.get("position"), O, "position_min") if "position" in of else (None, None)
     col = (None, None)
     if "color" in of:

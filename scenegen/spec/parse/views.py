@@ -10,9 +10,10 @@ from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.optics import parse_motion
 from scenegen.spec.parse.read import read_float, read_floats, read_int, read_vec3, seed_or_none
+from scenegen.spec.parse.timeline import parse_trajectory
 from scenegen.spec.parse.transforms import parse_pose
 
-PLACEMENTS = ("orbit", "look_at", "poses", "random", "path")
+PLACEMENTS = ("orbit", "look_at", "poses", "random", "path", "trajectory")
 
 
 def parse_view_set(node: Node, index: int, ctx: ParseContext) -> mv.ViewSet:
@@ -32,8 +33,15 @@ def parse_view_set(node: Node, index: int, ctx: ParseContext) -> mv.ViewSet:
             raise rn.error(f"undefined rig {rig!r}{suggest(rig, ctx.rigs)}; defined under "
                            f"rigs: {defined}")
     kind = f.one_of(PLACEMENTS)
+    if (kind == "trajectory") != (ctx.sequence is not None):
+        raise f.get(kind).error("a trajectory needs a top-level 'sequence:' section (its clock)"
+                                if kind == "trajectory" else "in a sequence every view set follows "
+                                "a 'trajectory' (one view per frame of the clock)")
+    if kind == "trajectory" and "motion" in f:
+        raise f.get("motion").error("'motion' cannot be combined with a trajectory: within the "
+                                    "exposure the camera follows the trajectory itself")
     parse = {"orbit": parse_orbit, "look_at": parse_look_at_list, "poses": parse_poses,
-             "random": parse_random, "path": parse_path}[kind]
+             "random": parse_random, "path": parse_path, "trajectory": parse_trajectory_path}[kind]
     placement = parse(f.get(kind), "rig" if rig else "cam", ctx)
     return mv.ViewSet(name=name, camera=camera, rig=rig, placement=placement,
                       motion=parse_motion(f.get("motion")) if "motion" in f else None,
@@ -79,6 +87,11 @@ def parse_view_lights(node: Node, ctx: ParseContext):
         raise node.error("expected at least one light (an empty list or mapping would turn "
                          "every light off; give {name: 0} to do that on purpose)")
     return frozen_mapping({name: given.get(name, 0.0) for name in names})
+
+
+def parse_trajectory_path(node: Node, frame: str, ctx: ParseContext) -> mv.TrajectoryPath:
+    return mv.TrajectoryPath(trajectory=parse_trajectory(node, frame),
+                             times_s=ctx.sequence.timestamps_s)
 
 
 def parse_orbit(node: Node, frame: str, ctx: ParseContext) -> mv.Orbit:

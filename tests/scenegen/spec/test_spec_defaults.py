@@ -54,6 +54,9 @@ def test_every_value_field_is_in_the_reference_table():
 
 # (record, field, spec text, the parsed value, another valid default)
 S = lambda i: (lambda s: s.objects[0].geometry)  # noqa: E731
+SEQ = "sequence: {fps: 10, frames: 3}\n"
+JOINT = ("objects:\n  - {name: a, shape: box}\n  - {name: b, shape: box, parent: a, joint: {type: "
+         "revolute, axis: [0, 0, 1], keyframes: [{time_s: 0, angle_deg: 0}]}}\n")
 CASES = [
     *[(m.RenderSettings, k, "render: {}\n", lambda s, k=k: getattr(s.render, k), v)
       for k, v in (("spp", 16), ("max_depth", 3), ("seed", 5), ("variant", "scalar_rgb"),
@@ -158,6 +161,16 @@ CASES = [
       for k, v in (("principal_point_px", 1.0), ("dist_jitter", (0.5,)))],
     *[(m.PoseJitter, k, "variation: {views: {}}\n", lambda s, k=k: getattr(s.variation.views, k),
        v) for k, v in (("translation_m", 0.01), ("rotation_deg", 1.0))],
+    *[(m.SequenceSpec, k, SEQ, lambda s, k=k: getattr(s.sequence, k), v)
+      for k, v in (("flow_steps", (2,)), ("start_s", 0.5))],
+    *[(m.TrackSpec, k, SEQ.replace("frames: 3", "frames: 3, tracks: {}"),
+       lambda s, k=k: getattr(s.sequence.tracks, k), v)
+      for k, v in (("count", 10), ("query_frames", (1,)))],
+    (m.TrajectorySpec, "interpolation", CAM + SEQ + "views:\n  - camera: cam\n    trajectory: "
+     "{keyframes: [{time_s: 0, eye: [0, -2, 1], target: [0, 0, 0]}]}\n",
+     lambda s: s.view_sets[0].placement.trajectory.interpolation, "linear"),
+    *[(m.JointSpec, k, SEQ + JOINT, lambda s, k=k: getattr(s.objects[1].animation.joint, k), v)
+      for k, v in (("origin", (0.1, 0.0, 0.0)), ("interpolation", "linear"))],
 ]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 

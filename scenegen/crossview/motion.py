@@ -1,0 +1,63 @@
+"""Truth across time: where the surface point behind each pixel of frame a is at frame b, with
+the objects moved (numpy only; the visibility test at b is a function passed in).
+
+The core, for pixel p of frame a with surface point P_a (world) on object o:
+``X = object_from_world_o(a) @ P_a`` (object coordinates), ``P_b = world_from_object_o(b) @ X``,
+then b's single camera model projects P_b (:func:`scenegen.crossview.correspondence.correspond`),
+and the ray cast of b's scene decides its state: VISIBLE, OCCLUDED, OUT_OF_FRAME, as for the
+static correspondences. A point whose object does not exist at b (outside its ``visible_s``) is
+OCCLUDED wherever it projects into b's image. Scene flow is ``P_b - P_a`` in the world frame.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import numpy as np
+
+from scenegen.crossview.correspondence import correspond
+from scenegen.dataset.crossview import OCCLUDED, VISIBLE, Correspondence
+from scenegen.dataset.sequence import MotionTruth
+from scenegen.geometry.pose import Rigid3
+
+Poses = Mapping[int, tuple[Rigid3, bool]]  # object id -> (world_from_object, present)
+
+
+def _apply(T: Rigid3, P: np.ndarray) -> np.ndarray:
+    """``T.apply(P)`` per component (no BLAS thread pool next to Dr.Jit's: 10x faster here)."""
+    out = np.empty_like(P)
+    for i in range(3):
+        out[:, i] = T.R[i, 0] * P[:, 0] + T.R[i, 1] * P[:, 1] + T.R[i, 2] * P[:, 2] + T.t[i]
+    return out
+
+
+def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tuple[np.ndarray, np.ndarray]:
+    """((N, 3) float64 points at b, (N,) bool their object exists at b) of points (N, 3) at a on
+    objects ``object_ids`` (N,) (0 or unknown: no object, the point stays where it is)."""
+    P = np.asarray(points_world, np.float64).reshape(-1, 3)
+    ids = np.asarray(object_ids).reshape(-1)
+    out = P.copy()
+    present = np.ones(len(P), bool)
+    for oid, (wa, _) in poses_a.items():
+        wb, pb = poses_b[oid]
+        still = wa.allclose(wb, 0.0)
+        if still and pb:
+            continue  # a static object: its points stay, all present (no pass over the pixels)
+        sel = np.flatnonzero(ids == oid)
+        if not still:
+            out[sel] = _apply(wb @ wa.inverse(), P[sel])
+        present[sel] = pb
+    return out, present
+
+
+def moved_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: Poses, camera_b,
+                         cam_b_from_world: Rigid3,
+                         visible_fn_b: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> MotionTruth:
+    """Motion truth of a's truth points (H, W, 3) (float64, NaN = no surface) on objects (H, W) at
+    frame b. ``visible_fn_b(center_world, points (M, 3)) -> (M,) bool`` casts in b's scene."""
+    P = np.asarray(points_world_a, np.float64)
+    H, W, _ = P.shape
+    Pb, present = move_points(P.reshape(-1, 3), object_ids_a, poses_a, poses_b)
+    c = correspond(Pb.reshape(H, W, 3), camera_b, cam_b_from_world, visible_fn_b)
+    state = c.state.copy()
+    state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
+    return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)

@@ -1,0 +1,159 @@
+"""The sequence stage of the pipeline: runs after every view of a sequence is rendered and writes
+its truth across time (docs/crossview.md, "Sequences") through the dataset writer: every
+object's pose per frame, flow / scene flow / occlusion for frame pairs (k, k + step) of each
+camera stream both ways, and point tracks.
+
+Truth points of frame a come from the truth pass at a's time in float64 (centre + range * ray,
+range from the float32 intersection); the scene is moved to b's time for b's visibility casts
+(:meth:`scenegen.render.scene.LoadedScene.set_time`). Only complete views take part; the index is
+written when every view is complete.
+"""
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+
+from scenegen.crossview.motion import moved_correspondence
+from scenegen.crossview.tracks import FrameGeometry, track_points
+from scenegen.dataset.codecs import TrackSet, encode_exr, encode_flo, encode_json, encode_tracks
+from scenegen.dataset.crossview import STATE_NAMES
+from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
+from scenegen.dataset.sequence import (
+    SCENE_FLOW_FRAME,
+    SEQUENCE_FORMAT,
+    SEQUENCE_FORMAT_VERSION,
+    encode_motion_channels,
+    objects_document,
+)
+from scenegen.geometry.seeds import hashed_seed32
+from scenegen.pipeline.pairs import streams
+from scenegen.pipeline.view import rolling_shutter_rows, view_truth
+from scenegen.spec.timeline import Timeline
+
+
+class SequenceTruth:
+    """Truth of a sequence's frames: float64 points, object ids, poses, visibility at a time."""
+
+    def __init__(self, spec, built, keep_frames: int = 8):
+        self.spec, self.built = spec, built
+        self.timeline = Timeline(spec)
+        self._frames: OrderedDict = OrderedDict()  # the last keep_frames frames' points (bounded memory)
+        self.keep_frames = max(2, int(keep_frames))
+
+    def frame(self, view) -> tuple[np.ndarray, np.ndarray]:
+        """((H, W, 3) float64 world points, NaN = no surface; (H, W) uint32 object ids) of a view."""
+        if view.name not in self._frames:
+            t = view_truth(self.built, view)  # at the view's time
+            cam = self.built.cameras[view.camera]
+            if rolling_shutter_rows(self.built, view) is None:
+                wfc = view.cam_from_world.inverse()
+                rays, R = self.built.camera_rays(cam), wfc.R
+                rng = np.where(t["valid"], t["range"], np.nan).reshape(-1)
+                # per component, without a BLAS call (no thread pool next to Dr.Jit's)
+                P = np.empty((len(rng), 3))
+                for i in range(3):
+                    P[:, i] = wfc.t[i] + rng * (R[i, 0] * rays[:, 0] + R[i, 1] * rays[:, 1] + R[i, 2] * rays[:, 2])
+                P = P.reshape(cam.height, cam.width, 3)
+            else:  # per-row poses: the kernel's float32 points
+                P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(np.float64)
+            self._frames[view.name] = (P, t["object_id"].copy())
+            while len(self._frames) > self.keep_frames:
+                self._frames.popitem(last=False)
+        self._frames.move_to_end(view.name)
+        return self._frames[view.name]
+
+    def poses(self, view):
+        return self.timeline.poses_by_id(view.time_s)
+
+    def visible_fn(self, view):
+        def visible(center, points):
+            self.built.set_time(view.time_s)
+            return self.built.visible_from(center, points)
+        return visible
+
+    def motion(self, a, b):
+        P, ids = self.frame(a)
+        return moved_correspondence(P, ids, self.poses(a), self.poses(b), self.built.cameras[b.camera],
+                                    b.cam_from_world, self.visible_fn(b))
+
+
+def stream_name(vs_prefix: str, member: str | None) -> str:
+    return vs_prefix if member is None else f"{vs_prefix}_{member}"
+
+
+def query_pixels(ids: np.ndarray, valid: np.ndarray, animated_ids, count: int, seed: int) -> np.ndarray:
+    """(n, 2) int pixels (x, y) of a query frame: up to half on animated objects (where any is
+    seen), the rest elsewhere on surfaces, without repeats, drawn with default_rng(seed)."""
+    rng = np.random.default_rng(seed)
+    flat = np.flatnonzero(valid.ravel())
+    moving = np.isin(ids.ravel()[flat], np.asarray(sorted(animated_ids), np.uint32))
+    on_moving, still = flat[moving], flat[~moving]
+    n_moving = min(len(on_moving), count // 2 if len(still) else count)
+    n_still = min(len(still), count - n_moving)
+    pick = np.concatenate([rng.choice(on_moving, n_moving, replace=False),
+                           rng.choice(still, n_still, replace=False)]).astype(np.int64)
+    W = valid.shape[1]
+    return np.stack([pick % W, pick // W], 1)
+
+
+def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
+    """The tracks of one stream (frames ``vs`` in order)."""
+    frames = [FrameGeometry(st.poses(v), st.built.cameras[v.camera], v.cam_from_world, st.visible_fn(v))
+              for v in vs]
+    animated = {o.object_id for o in st.spec.objects if o.animation is not None}
+    qs = [q for q in cfg.query_frames if q < len(vs)]
+    queries, groups = [], []
+    for i, q in enumerate(qs):
+        P, ids = st.frame(vs[q])
+        n = cfg.count // len(qs) + (1 if i < cfg.count % len(qs) else 0)
+        px = query_pixels(ids, np.isfinite(P[..., 0]), animated, n, hashed_seed32(cfg.seed, name, q))
+        groups.append((P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.poses(vs[q])))
+        queries.append(np.column_stack([np.full(len(px), q), px[:, 1], px[:, 0]]))
+    xy, occ, oof = track_points(groups, frames)  # each frame's scene cast once for every query
+    cam = st.built.cameras[vs[0].camera]
+    return TrackSet(query_points=np.concatenate(queries), tracks_xy=xy, occluded=occ, out_of_frame=oof,
+                    image_size=np.array([cam.width, cam.height]), frame_names=np.array([v.name for v in vs]))
+
+
+def run_sequence(spec, views, built, writer) -> dict | None:
+    """Write the sequence truth of ``spec.sequence`` (nothing for a static spec); the index."""
+    seq = getattr(spec, "sequence", None)
+    if seq is None:
+        return None
+    # frames a step away on both sides stay cached while the targets are walked in order
+    st = SequenceTruth(spec, built, keep_frames=2 * max(seq.flow_steps) + 2)
+    done = [v for v in views if writer.is_complete(v.name)]
+    names = {v.name for v in done}
+    files: list[str] = []
+
+    def write(rel, data):
+        writer.write_file(rel, data)
+        files.append(rel)
+
+    frames = [(k, t, {o.name: (o.object_id, s) for o, s in zip(spec.objects, st.timeline.states(t).values())})
+              for k, t in enumerate(seq.timestamps_s)]
+    write(SEQUENCE_OBJECTS, encode_json(objects_document(frames)))
+    index = {"format": SEQUENCE_FORMAT, "format_version": SEQUENCE_FORMAT_VERSION,
+             "timestamps_s": list(seq.timestamps_s), "scene_flow_frame": SCENE_FLOW_FRAME,
+             "state_codes": {str(k): v for k, v in STATE_NAMES.items()}, "pairs": [], "tracks": []}
+    for (set_index, member), vs in streams(views).items():
+        name = stream_name(spec.view_sets[set_index].prefix, member)
+        jobs = []  # (position of the target frame, source, target): one scene move per target
+        for step in seq.flow_steps:
+            for k, (a, b) in enumerate(zip(vs, vs[step:])):
+                if a.name not in names or b.name not in names:
+                    continue
+                jobs += [(k + step, a, b), (k, b, a)]
+                index["pairs"].append({"a": a.name, "b": b.name, "step": step})
+        for _, i, j in sorted(jobs, key=lambda job: job[0]):
+            m = st.motion(i, j)
+            write(motion_path(i.name, j.name), encode_exr(encode_motion_channels(m)))
+            write(sequence_flow_path(i.name, j.name), encode_flo(m.flow))
+        if seq.tracks is not None and all(v.name in names for v in vs):
+            write(tracks_path(name), encode_tracks(stream_tracks(st, vs, name, seq.tracks)))
+            index["tracks"].append({"stream": name, "frames": [v.name for v in vs]})
+    index["files"] = sorted(files)
+    if len(done) == len(views):
+        writer.write_file(SEQUENCE_INDEX, encode_json(index))
+    return index

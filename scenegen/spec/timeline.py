@@ -1,0 +1,96 @@
+"""A spec over time: where every object is, how fast it moves and whether it exists at a time
+on the sequence clock (numpy only; the renderer and the truth both ask here).
+
+``world_from_object(t) = world_from_parent(t) @ parent_from_object(t)`` (docs/scene_spec.md,
+"Sequences"): parent_from_object is the object's trajectory, its joint, or its fixed ``rest``;
+an object without a parent hangs from the world. A static object (no ``animation``) stays at its
+``transform``. Poses are rigid (no scale): the scale of ``transform`` acts in the object frame.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.trajectory import MotionState
+
+
+@dataclass(frozen=True, eq=False)
+class ObjectState:
+    """An object at one time: its motion (pose + world-frame derivatives) and whether it exists."""
+
+    motion: MotionState
+    present: bool
+
+    @property
+    def world_from_object(self) -> Rigid3:
+        return self.motion.world_from_frame
+
+
+class _Fixed:
+    def __init__(self, pose: Rigid3):
+        self.pose_ = pose
+
+    def state(self, t_s: float) -> MotionState:
+        return MotionState.still(self.pose_)
+
+
+def local_trajectory(animation):
+    """The trajectory of parent_from_object (an object with ``.state(t) -> MotionState``)."""
+    if animation.trajectory is not None:
+        return animation.trajectory.trajectory()
+    if animation.joint is not None:
+        return animation.joint.trajectory(animation.rest)
+    return _Fixed(animation.rest)
+
+
+def is_animated(obj) -> bool:
+    return getattr(obj, "animation", None) is not None
+
+
+def present_at(obj, t_s: float) -> bool:
+    """The object exists at ``t_s`` (inside its closed ``visible_s`` interval, or always)."""
+    a = getattr(obj, "animation", None)
+    if a is None or a.visible_s is None:
+        return True
+    return a.visible_s[0] <= t_s <= a.visible_s[1]
+
+
+def object_states(objects, t_s: float, *, trajectories: dict | None = None) -> dict[str, ObjectState]:
+    """{object name: :class:`ObjectState`} at ``t_s`` for every object, in spec order (a parent
+    comes before its children). ``trajectories``: a cache {name: local trajectory} to reuse."""
+    cache = {} if trajectories is None else trajectories
+    out: dict[str, ObjectState] = {}
+    for obj in objects:
+        a = getattr(obj, "animation", None)
+        if a is None:
+            out[obj.name] = ObjectState(MotionState.still(obj.transform.world_from_object), True)
+            continue
+        if obj.name not in cache:
+            cache[obj.name] = local_trajectory(a)
+        local = cache[obj.name].state(float(t_s))
+        state = out[a.parent].motion.compose(local) if a.parent is not None else local
+        parent_present = out[a.parent].present if a.parent is not None else True
+        out[obj.name] = ObjectState(state, parent_present and present_at(obj, t_s))
+    return out
+
+
+class Timeline:
+    """Object states of a spec at any time, the local trajectories built once."""
+
+    def __init__(self, spec):
+        self.objects = tuple(spec.objects)
+        self.sequence = getattr(spec, "sequence", None)
+        self._cache: dict = {}
+
+    @property
+    def animated(self) -> tuple[str, ...]:
+        """Names of the objects that move or appear/leave, in spec order."""
+        return tuple(o.name for o in self.objects if is_animated(o))
+
+    def states(self, t_s: float) -> dict[str, ObjectState]:
+        return object_states(self.objects, t_s, trajectories=self._cache)
+
+    def poses_by_id(self, t_s: float) -> dict[int, tuple[Rigid3, bool]]:
+        """{object id: (world_from_object, present)} at ``t_s``."""
+        s = self.states(t_s)
+        return {o.object_id: (s[o.name].world_from_object, s[o.name].present) for o in self.objects}
