@@ -31,8 +31,9 @@ from recon_eval.metrics.poses import Poses
 from scenegen.dataset import CAMERAS, MANIFEST, Dataset, DatasetError
 from scenegen.dataset.crossview import VISIBLE, Correspondence, CrossviewIndex, MatchSet
 from scenegen.dataset.crossview_reader import TwoViewTruth
-from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, correspondence_path, flow_path,
-                                     mesh_path, stereo_path, twoview_path, view_paths)
+from scenegen.dataset.codecs import TrackSet
+from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, SEQUENCE_INDEX, correspondence_path,
+                                     flow_path, mesh_path, motion_path, stereo_path, twoview_path, view_paths)
 from scenegen.geometry.conventions import in_image
 from scenegen.geometry.twoview import fundamental
 
@@ -272,17 +273,43 @@ class DatasetTruth:
         return x1[ok], x2[ok]
 
     def flow_pairs(self) -> tuple:
-        """(i, j) of every flow pair the dataset holds, both directions, in index order (flow is
-        written between consecutive frames of a camera stream); NotApplicable without an index."""
+        """(i, j) of every flow pair the dataset holds, both directions, in index order: a
+        sequence's frame pairs (every flow step, moving objects included) when it is one, else the
+        consecutive frames of the cross-view index; NotApplicable without either index."""
+        seq = self._read(lambda: self._ds.sequence.index)
+        if seq is not None:
+            return tuple(p for a, b, _ in seq.pairs for p in ((a, b), (b, a)))
         return tuple(p for i, j in self.require_crossview_index().flow for p in ((i, j), (j, i)))
+
+    def track_streams(self) -> dict:
+        """{stream: its frames (view names, in order)} of a sequence's point tracks;
+        NotApplicable when the dataset has none."""
+        seq = self._read(lambda: self._ds.sequence.index)
+        if seq is None or not seq.streams:
+            raise NotApplicable(f"{self._ds.path(SEQUENCE_INDEX)}: no such file or no point tracks: the dataset is "
+                                "not a sequence with 'sequence.tracks'")
+        return dict(seq.streams)
+
+    def tracks_truth(self, stream: str) -> TrackSet:
+        """The truth point tracks of a camera stream (scenegen.dataset.codecs.tracks)."""
+        streams = self.track_streams()
+        if stream not in streams:
+            raise InputError(f"unknown stream {stream!r}; the dataset's: {', '.join(streams)}")
+        return self._read(self._ds.sequence.tracks, stream)
 
     def flow_truth(self, view1: str, view2: str):
         """``(flow (H, W, 2) float64 px, states (H, W) uint8 or None, source)`` of view1 -> view2:
+        a sequence's motion truth of the pair (flow and occlusion states at view2's time), else
         the dataset's flow file when it has one (consecutive frames), else the correspondence
         field ``uv - pixel`` of a crossview pair; the occlusion states from the correspondence file
         when the dataset has it (None otherwise). NaN where the flow is unknown."""
         self.check_view(view1)
         self.check_view(view2)
+        if self._ds.has(motion_path(view1, view2)):  # a sequence's frame pair, moving objects too
+            m = self._read(self._ds.sequence.motion, view1, view2)
+            flow = np.array(m.flow, dtype=np.float64)
+            flow[~np.all(np.isfinite(flow), axis=2)] = np.nan
+            return flow, m.state, str(motion_path(view1, view2))
         has_corr = self._ds.crossview.has_correspondence(view1, view2)
         corr = self._read(self._ds.crossview.correspondence, view1, view2) if has_corr else None
         if self._ds.has(flow_path(view1, view2)):

@@ -54,7 +54,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks",
+         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
@@ -101,6 +101,8 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-flow-farneback", "flow", "dense", "cv2.calcOpticalFlowFarneback (tutorial parameters) on the flow pairs",
        algorithm="farneback"),
     _m("opencv-lk-tracks", "flow", "lk", "cv2.goodFeaturesToTrack + calcOpticalFlowPyrLK (21 px, 3 levels) tracks"),
+    _m("opencv-lk-tapvid", "tracking", "lk_tapvid",
+       "chained cv2.calcOpticalFlowPyrLK (21 px, 3 levels, forward-backward check) from the truth query points"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

@@ -1,5 +1,5 @@
-"""OpenCV optical flow on a dataset's flow pairs (consecutive frames of each camera stream, both
-directions; without any, its crossview pairs), scored against the dataset's flow with its
+"""OpenCV optical flow on a dataset's flow pairs (a sequence's frame pairs, moving objects included;
+else consecutive frames of each camera stream, both directions; without any, its crossview pairs), scored against the dataset's flow with its
 occlusion states (:meth:`recon_eval.readers.scenegen_dataset.DatasetTruth.flow_truth`). Images
 reach OpenCV as :func:`scenegen.geometry.color.to_grey8` of the stored RGB.
 
@@ -31,8 +31,9 @@ from scenegen.geometry.color import to_grey8
 
 
 def _pairs(ds) -> list:
-    idx = ds.require_crossview_index()
-    pairs = list(ds.flow_pairs()) or [p for i, j in idx.pairs for p in ((i, j), (j, i))]
+    pairs = list(ds.flow_pairs())  # a sequence's frame pairs, else the cross-view flow pairs
+    if not pairs:
+        pairs = [p for i, j in ds.require_crossview_index().pairs for p in ((i, j), (j, i))]
     if not pairs:
         raise NotApplicable(f"{ds.root}: no flow or crossview pairs (crossview/index.json: flow, pairs)")
     return pairs

@@ -16,6 +16,15 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
+from recon_eval.metrics.tapvid import TAPVID_EVAL_SIZE
+from recon_eval.readers.tracks import read_tracks
+from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.tracks import score_streams
+from scenegen.dataset.codecs import encode_npz
+from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.layout import check_name
+from scenegen.geometry.color import to_grey8
+
 #: Forward-backward error above which a point counts as lost (px).
 FB_MAX_PX = 1.0
 LK_PARAMS = {"winSize": (21, 21), "maxLevel": 3,
@@ -64,3 +73,25 @@ def lk_tracks(frames_grey8: Sequence[np.ndarray], query_points_tyx) -> tuple[np.
             else:
                 tracks[sel, :t] = p[:, None]
     return tracks, occluded
+
+
+def lk_tapvid(ds, out_dir, options) -> RunOutput:
+    """The LK chain on every stream of a sequence with point tracks, from the truth's query
+    points; raw output ``tracks/<stream>.npz`` (``tracks_xy``, ``occluded``), scored from the files
+    with TAP-Vid's metrics at 256 x 256, query mode ``first``."""
+    streams = ds.track_streams()
+    raw = []
+    for stream, frames in streams.items():
+        truth = ds.tracks_truth(stream)
+        tracks, occ = lk_tracks([to_grey8(ds.image(v)) for v in frames], truth.query_points)
+        rel = f"tracks/{check_name('stream', stream)}.npz"
+        atomic_write_bytes(out_path(out_dir, rel), encode_npz({"tracks_xy": tracks.astype(np.float32),
+                                                               "occluded": occ}))
+        raw.append(rel)
+    res = score_streams(ds, streams, lambda s, n, t: read_tracks(out_path(out_dir, f"tracks/{s}.npz"), n, t),
+                        query_mode="first", eval_size=TAPVID_EVAL_SIZE)
+    mean = res["mean"]
+    metrics = {"average_jaccard": mean["average_jaccard"], "average_pts_within": mean["average_pts_within"],
+               "occlusion_accuracy": mean["occlusion_accuracy"]}
+    return RunOutput({"tapvid": res}, metrics, raw, {"streams": list(streams), "query_mode": "first",
+                                                     "eval_size": list(TAPVID_EVAL_SIZE)})

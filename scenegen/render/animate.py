@@ -17,6 +17,7 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.arrays import to_jit
+from scenegen.render.objects import placed_geometry
 
 
 @dataclass
@@ -33,14 +34,7 @@ class Animated:
 
 def animated_entry(key: str, obj, entry, mesh_world) -> Animated:
     """What :func:`place_animated` needs of an animated object."""
-    if isinstance(entry, dict):  # the analytic sphere
-        return Animated(key, obj.name, obj.transform.world_from_object,
-                        sphere_to_world=np.array(entry["to_world"].matrix, dtype=np.float64))
-    normals = None
-    if entry.has_vertex_normals():
-        normals = np.asarray(mesh_world.vertex_normals, dtype=np.float64)
-    return Animated(key, obj.name, obj.transform.world_from_object,
-                    vertices=np.asarray(mesh_world.vertices, dtype=np.float64), normals=normals)
+    return Animated(key, obj.name, obj.transform.world_from_object, **placed_geometry(entry, mesh_world))
 
 
 def place_animated(built, t_s: float) -> None:

@@ -130,16 +130,21 @@ def _own_material_parts(obj, key: str, built) -> dict:
     return out
 
 
-def moving_entry(key: str, obj, entry, mesh_world) -> Moving:
-    """What :func:`place_moving_objects` needs of a moving object."""
+def placed_geometry(entry, mesh_world) -> dict:
+    """What moving a loaded object needs of its geometry at its spec pose: the analytic sphere's
+    ``sphere_to_world`` (4x4), or a mesh's world ``vertices`` (V, 3) and ``normals`` (V, 3; None
+    for flat shading), float64."""
     if isinstance(entry, dict):  # the analytic sphere
-        return Moving(key, obj.motion, obj.transform.world_from_object,
-                      sphere_to_world=np.array(entry["to_world"].matrix, dtype=np.float64))
+        return {"sphere_to_world": np.array(entry["to_world"].matrix, dtype=np.float64)}
     normals = None
     if entry.has_vertex_normals():
         normals = np.asarray(mesh_world.vertex_normals, dtype=np.float64)
-    return Moving(key, obj.motion, obj.transform.world_from_object,
-                  vertices=np.asarray(mesh_world.vertices, dtype=np.float64), normals=normals)
+    return {"vertices": np.asarray(mesh_world.vertices, dtype=np.float64), "normals": normals}
+
+
+def moving_entry(key: str, obj, entry, mesh_world) -> Moving:
+    """What :func:`place_moving_objects` needs of a moving object."""
+    return Moving(key, obj.motion, obj.transform.world_from_object, **placed_geometry(entry, mesh_world))
 
 
 def place_moving_objects(built, tau_s: float) -> None:
