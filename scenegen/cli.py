@@ -74,7 +74,8 @@ def cmd_render(args) -> int:
     with warnings.catch_warnings(), renderer_log(args.verbosity > QUIET):
         warnings.simplefilter("always")
         kw = dict(frames=args.frames, spp=args.spp, seed=args.seed, variant=args.variant,
-                  resume=args.resume, progress=args.verbosity > QUIET and not args.no_progress)
+                  resume=args.resume, progress=args.verbosity > QUIET and not args.no_progress,
+                  show_warnings=args.verbosity > QUIET)
         if many:  # variants and/or Dask workers (scenegen/batch.py)
             summaries = render_many(args.spec, args.output, variants=args.variants,
                                     workers=args.workers, scheduler=args.scheduler, **kw)

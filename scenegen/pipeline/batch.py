@@ -23,7 +23,8 @@ def render_many(spec_path, out_dir, *, variants: int | None = None, workers: int
                 scheduler: str | None = None, **render_kw) -> list:
     """Render the spec (or its ``variants`` variants) into ``out_dir``; returns the
     :class:`scenegen.pipeline.run.RenderSummary` of each dataset. ``render_kw`` go to
-    :func:`scenegen.pipeline.run.render_spec` (frames, spp, seed, variant, resume, progress)."""
+    :func:`scenegen.pipeline.run.render_spec` (frames, spp, seed, variant, resume, progress,
+    show_warnings)."""
     if variants is not None and variants < 1:
         raise ValueError(f"--variants must be at least 1, got {variants}")
     if workers is not None and scheduler is not None:

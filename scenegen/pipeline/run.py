@@ -68,19 +68,20 @@ def parse_frames(text: str | None, n_frames: int) -> set[int] | None:
 
 def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | None = None,
                 seed: int | None = None, variant: str | None = None, resume: bool = False,
-                progress: bool = True, dask_client=None) -> RenderSummary:
+                progress: bool = True, dask_client=None, show_warnings: bool = True) -> RenderSummary:
     """Render every selected view of a spec into ``out_dir`` (see docs/dataset_format.md).
 
     ``spec_path``: a spec file, or a :class:`scenegen.spec.source.SpecSource` (e.g. a variant).
     ``dask_client``: a ``distributed.Client``; its workers render and write the views, this
     process records them in the run's order (scenegen/pipeline/distributed.py); None = render here.
+    ``show_warnings``: the spec's warnings on stderr (``-q`` turns them off).
 
     Raises :class:`scenegen.errors.SpecError` for a bad spec, ``ValueError`` for bad options,
     :class:`scenegen.dataset.errors.DatasetError` for an unusable output directory.
     """
     source = spec_path if isinstance(spec_path, SpecSource) else None
     spec = source.load() if source is not None else load_spec(spec_path)
-    for w in spec.warnings:  # e.g. a spec material replacing a mesh file's own materials
+    for w in spec.warnings if show_warnings else ():  # e.g. a spec material replacing a mesh's own
         print(f"warning: {w}", file=sys.stderr)
     views = resolve_views(spec)
     n_frames = 1 + max((v.frame_index for v in views), default=-1)

@@ -75,7 +75,7 @@ def write_glb(folder, tex, **pbr):
 def render(folder, tag, mesh, extra="", capsys=None):
     spec = folder / f"{tag}.yaml"
     spec.write_text(SCENE.format(tag=tag, mesh=mesh, extra=extra))
-    assert main(["render", str(spec), "-o", str(folder / f"out_{tag}"), "-q"]) == 0
+    assert main(["render", str(spec), "-o", str(folder / f"out_{tag}"), "--no-progress"]) == 0
     ds = Dataset(folder / f"out_{tag}")
     return ds, ds.linear_image(ds.views[0]), ds.truth(ds.views[0])
 
