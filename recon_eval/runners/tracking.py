@@ -90,7 +90,7 @@ def lk_tapvid(ds, out_dir, options) -> RunOutput:
         raw.append(rel)
     res = score_streams(ds, streams, lambda s, n, t: read_tracks(out_path(out_dir, f"tracks/{s}.npz"), n, t),
                         query_mode="first", eval_size=TAPVID_EVAL_SIZE)
-    mean = res["mean"]
+    mean = res["mean_over_streams"]
     metrics = {"average_jaccard": mean["average_jaccard"], "average_pts_within": mean["average_pts_within"],
                "occlusion_accuracy": mean["occlusion_accuracy"]}
     return RunOutput({"tapvid": res}, metrics, raw, {"streams": list(streams), "query_mode": "first",
