@@ -7,11 +7,9 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-import pytest
+import pycolmap  # a dev dependency (pyproject.toml): required, never skipped
 
-pycolmap = pytest.importorskip("pycolmap")
-
-from recon_eval.runners import colmap  # noqa: E402  (after the optional dependency is known)
+from recon_eval.runners import colmap
 
 
 def test_every_stage_is_single_threaded_and_seeded(tmp_path, monkeypatch):

@@ -10,6 +10,7 @@ import sys
 import time
 from pathlib import Path
 
+import distributed
 import pytest
 
 from scenegen.cli import main
@@ -70,7 +71,6 @@ def _wait(cond, what: str, timeout_s: float = 60.0):
 
 @pytest.mark.render
 def test_worker_killed_mid_write_leaves_no_temp_file(tmp_path):
-    distributed = pytest.importorskip("distributed")
     spec = tmp_path / "scene.yaml"
     spec.write_text(SPEC)
     (tmp_path / "die_mid_write.py").write_text(DIE_MID_WRITE)
