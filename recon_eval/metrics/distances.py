@@ -120,16 +120,23 @@ def surface_distances(query, gt_mesh) -> np.ndarray:
     return mesh_surface_distances(query, vertices, faces)
 
 
-def sample_mesh_surface(vertices, faces, n: int, *, seed: int) -> np.ndarray:
-    """n points (n, 3) uniformly distributed over the mesh surface (area-weighted), seeded."""
+def sample_mesh_surface(vertices, faces, n: int, *, seed: int, with_normals: bool = False):
+    """n points (n, 3) uniformly distributed over the mesh surface (area-weighted), seeded; with
+    ``with_normals`` also the unit normal (n, 3) of each point's face."""
     V = as_float_array(vertices, "mesh vertices", (None, 3))
     Fc = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     tri = V[Fc]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    if not area.sum() > 0:
+        raise InputError("mesh: zero surface area")
     rng = np.random.default_rng(seed)
     k = rng.choice(len(Fc), size=n, p=area / area.sum())
     u, v = rng.random(n), rng.random(n)
     flip = u + v > 1
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
     t = tri[k]
-    return t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
+    pts = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
+    if not with_normals:
+        return pts
+    return pts, cross[k] / np.linalg.norm(cross[k], axis=1, keepdims=True)

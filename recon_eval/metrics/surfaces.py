@@ -20,6 +20,7 @@ from scipy.spatial import cKDTree
 
 from recon_eval.arrays import as_float_array
 from recon_eval.errors import InputError
+from recon_eval.metrics.distances import sample_mesh_surface
 
 
 def _mesh(vertices, faces, name: str):
@@ -35,19 +36,7 @@ def _mesh(vertices, faces, name: str):
 def sample_with_normals(vertices, faces, n: int, *, seed: int):
     """n surface samples (n, 3), area-weighted and seeded, with the unit normal of their face."""
     V, F = _mesh(vertices, faces, "mesh")
-    tri = V[F]
-    cr = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area = 0.5 * np.linalg.norm(cr, axis=1)
-    if not area.sum() > 0:
-        raise InputError("mesh: zero surface area")
-    rng = np.random.default_rng(seed)
-    k = rng.choice(len(F), size=n, p=area / area.sum())
-    u, v = rng.random(n), rng.random(n)
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    t = tri[k]
-    pts = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
-    return pts, cr[k] / np.linalg.norm(cr[k], axis=1, keepdims=True)
+    return sample_mesh_surface(V, F, n, seed=seed, with_normals=True)
 
 
 def normal_consistency_of_samples(points_src, normals_src, points_tgt, normals_tgt) -> tuple[float, float, float]:

@@ -26,7 +26,7 @@ from scenegen.dataset.crossview import VISIBLE
 from scenegen.export.common import each, fmt, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
-from scenegen.geometry.conventions import colmap_from_opencv_pixels, colmap_pose
+from scenegen.geometry.conventions import colmap_from_opencv_pixels, colmap_pose, in_image
 
 STRIDE_PX = 8
 HEAD = "# written by scenegen export (truth; pixels in COLMAP's convention)\n"
@@ -79,8 +79,7 @@ def tracks(ds, cams: dict, poses: dict, vid: dict, progress=None) -> tuple[dict[
             seen = []
             for view in [i] + [j for j in others if vis[j][k]]:
                 uv = cams[view].project(poses[view].apply(X[None]))[0]
-                inside = 0 <= uv[0] + 0.5 <= cams[view].width and 0 <= uv[1] + 0.5 <= cams[view].height
-                if np.all(np.isfinite(uv)) and inside:
+                if in_image(uv[None], cams[view].width, cams[view].height)[0]:  # NaN is outside
                     seen.append((view, uv))
             if len(seen) < min_track:
                 continue

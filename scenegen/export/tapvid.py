@@ -5,7 +5,8 @@ Any Point in a Video", NeurIPS 2022; the per-video dicts of its DAVIS/Kinetics p
 * ``video`` (T, H, W, 3) uint8: the stream's rendered frames (16-bit images rounded to 8 bit by
   :func:`scenegen.geometry.color.to_uint8`);
 * ``points`` (N, T, 2) float32: ``[x, y]`` normalised to the image, TAP-Vid's raw form:
-  ``((x + 0.5) / W, (y + 0.5) / H)`` of our pixel coordinates (ours put the top-left pixel's
+  ``((x + 0.5) / W, (y + 0.5) / H)`` of our pixel coordinates
+  (:func:`scenegen.geometry.conventions.normalised_from_opencv_pixels`; ours put the top-left pixel's
   centre at (0, 0); TAP-Vid's normalised coordinates put the image's top-left corner at (0, 0)
   and its bottom-right corner at (1, 1));
 * ``occluded`` (N, T) bool: TAP-Vid's occlusion flag (out of frame counts as occluded);
@@ -22,6 +23,7 @@ from scenegen.dataset.codecs import encode_npz
 from scenegen.export.common import name, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
+from scenegen.geometry.conventions import normalised_from_opencv_pixels
 
 
 def export(ds, dest, progress=None) -> dict:
@@ -31,10 +33,10 @@ def export(ds, dest, progress=None) -> dict:
     for k, (stream, frames) in enumerate(index.streams.items(), 1):
         tr = ds.sequence.tracks(stream)
         w, h = (float(x) for x in tr.image_size)
-        scale = np.array([w, h], np.float64)
-        points = ((tr.tracks_xy.astype(np.float64) + 0.5) / scale).astype(np.float32)
+        points = normalised_from_opencv_pixels(tr.tracks_xy.astype(np.float64), (w, h)).astype(np.float32)
         q = tr.query_points.astype(np.float64)
-        query = np.column_stack([q[:, 0], (q[:, 1] + 0.5) / h, (q[:, 2] + 0.5) / w]).astype(np.float32)
+        q_xy = normalised_from_opencv_pixels(q[:, [2, 1]], (w, h))
+        query = np.column_stack([q[:, 0], q_xy[:, 1], q_xy[:, 0]]).astype(np.float32)
         video = np.stack([to_uint8(ds.image(v)) for v in frames])
         if video.ndim == 3:  # grey images: three equal channels, as TAP-Vid's videos are RGB
             video = np.repeat(video[..., None], 3, axis=-1)

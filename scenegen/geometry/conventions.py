@@ -99,6 +99,19 @@ def opencv_from_colmap_pixels(uv):
     return np.asarray(uv, dtype=np.float64) - 0.5
 
 
+def normalised_from_opencv_pixels(uv, size):
+    """Coordinates over the image area, (0, 0) at the image's top-left corner and (1, 1) at its
+    bottom-right corner (TAP-Vid's normalised points), from OpenCV pixels (..., 2) of an image of
+    ``size`` (width, height): ``(uv + 0.5) / size``."""
+    return colmap_from_opencv_pixels(uv) / np.asarray(size, dtype=np.float64)
+
+
+def rescaled_opencv_pixels(uv, scale):
+    """OpenCV pixels of the same image points after the image is resized by ``scale`` (sx, sy):
+    the image's corners stay at its corners, so ``(uv + 0.5) * scale - 0.5``."""
+    return opencv_from_colmap_pixels(colmap_from_opencv_pixels(uv) * np.asarray(scale, dtype=np.float64))
+
+
 def opencv_pixel_from_film(sample, size, offset=(0, 0)):
     """OpenCV pixel from Mitsuba's film sample position in [0, 1]^2 over a crop window.
 

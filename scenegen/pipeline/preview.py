@@ -18,6 +18,7 @@ from pathlib import Path
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.files import atomic_write_bytes
 from scenegen.export.sheet import compose, view_tiles
+from scenegen.geometry.conventions import rescaled_opencv_pixels
 from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import load_scene
@@ -30,9 +31,9 @@ def scaled_camera(cam, width: int):
         return cam
     height = max(1, round(cam.height * width / cam.width))
     sx, sy = width / cam.width, height / cam.height
+    cx, cy = rescaled_opencv_pixels((cam.cx, cam.cy), (sx, sy))
     return dataclasses.replace(cam, width=width, height=height, fx=cam.fx * sx, fy=cam.fy * sy,
-                               cx=(cam.cx + 0.5) * sx - 0.5, cy=(cam.cy + 0.5) * sy - 0.5, skew=cam.skew * sx,
-                               fov_deg=None)
+                               cx=float(cx), cy=float(cy), skew=cam.skew * sx, fov_deg=None)
 
 
 def default_png(spec_path) -> Path:

@@ -96,3 +96,13 @@ def test_depth_and_range():
 def test_quaternion_rejects_zero():
     with pytest.raises(ValueError):
         cv.matrix_from_quat_wxyz([0, 0, 0, 0])
+
+
+def test_normalised_and_rescaled_pixels_keep_the_image_corners():
+    corners = np.array([[-0.5, -0.5], [639.5, 479.5]])  # outer corners of a 640x480 image, OpenCV px
+    assert np.array_equal(cv.normalised_from_opencv_pixels(corners, (640, 480)), [[0, 0], [1, 1]])
+    assert np.array_equal(cv.normalised_from_opencv_pixels([0.0, 0.0], (640, 480)), [0.5 / 640, 0.5 / 480])
+    half = cv.rescaled_opencv_pixels(corners, (0.5, 0.25))
+    assert np.array_equal(half, [[-0.5, -0.5], [319.5, 119.5]])
+    # pixel centre (1, 1) at scale 2 covers [2, 4] x [2, 4] in the corner frame: centre 3 - 0.5
+    assert np.array_equal(cv.rescaled_opencv_pixels([1.0, 1.0], (2, 2)), [2.5, 2.5])
