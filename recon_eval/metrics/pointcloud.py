@@ -192,26 +192,10 @@ def eth3d(
     are excluded. Both are averaged per voxel of size ``voxel_m`` (ETH3D's ``--voxel_size``,
     default 0.01 m) to cancel density: the score is the mean over occupied voxels of the fraction
     of good points in the voxel. F1 = 2AC/(A+C), 0 when both are 0. Empty cloud -> 0.
-    ETH3D tolerances: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m.
+    ETH3D tolerances: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m. (:func:`eth3d_table` at one tolerance.)
     """
-    rec = _check_cloud(points_rec, "reconstructed points")
-    gt = _check_cloud(points_gt, "GT points")
-    if not tolerance_m > 0 or not voxel_m > 0:
-        raise InputError("tolerance and voxel size must be > 0 metres")
-    observed = np.ones(len(rec), bool) if rec_observed is None else np.asarray(rec_observed, bool).reshape(-1)
-    if observed.shape != (len(rec),):
-        raise InputError(f"rec_observed: expected shape ({len(rec)},), got {observed.shape}")
-    rec_s = rec[observed]
-    to = DistanceTo.MESH if gt_mesh is not None else DistanceTo.POINTS
-    if len(rec_s) == 0 or len(gt) == 0:
-        return Eth3dResult(tolerance_m, 0.0, 0.0, 0.0, voxel_m, len(rec_s), int((~observed).sum()), len(gt), to.value)
-    d_rg, to = _rec_to_gt(rec_s, gt, gt_mesh)
-    d_gr = nearest_point_distances(gt, rec_s)
-    acc = _voxel_average(rec_s, d_rg <= tolerance_m, voxel_m)
-    comp = _voxel_average(gt, d_gr <= tolerance_m, voxel_m)
-    return Eth3dResult(
-        tolerance_m, acc, comp, _fscore(acc, comp), voxel_m, len(rec_s), int((~observed).sum()), len(gt), to.value
-    )
+    return eth3d_table(points_rec, points_gt, (tolerance_m,), gt_mesh=gt_mesh, rec_observed=rec_observed,
+                       voxel_m=voxel_m)[0]
 
 
 #: ETH3D's tolerance table (multi-view-evaluation: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m).
