@@ -69,6 +69,13 @@ def _rays(cam, uv: np.ndarray) -> np.ndarray:
     return np.asarray(cam.unproject(uv), dtype=np.float64)
 
 
+
+def _mean_max_rms(d: np.ndarray) -> tuple[float, float, float]:
+    """(mean, max, RMS) of the finite differences d (px); NaN each when there are none."""
+    if not len(d):
+        return float("nan"), float("nan"), float("nan")
+    return float(np.mean(d)), float(np.max(d)), float(np.sqrt(np.mean(d**2)))
+
 def projection_difference(cam_gt, cam_est, *, grid_nx: int = 60, grid_ny: int = 40,
                           fit_rotation: bool = False) -> ProjectionDiffResult:
     """mrcal-style projection difference (mrcal ``projection_diff``): grid the image (pixel
@@ -104,11 +111,8 @@ def projection_difference(cam_gt, cam_est, *, grid_nx: int = 60, grid_ny: int = 
     proj[ok] = np.asarray(cam_est.project(rays[ok] @ R.T), dtype=np.float64)
     d = np.linalg.norm(proj - uv, axis=1)
     valid = np.isfinite(d)
-    dv = d[valid]
-    nan = float("nan")
     return ProjectionDiffResult(
-        float(np.mean(dv)) if len(dv) else nan, float(np.max(dv)) if len(dv) else nan,
-        float(np.sqrt(np.mean(dv**2))) if len(dv) else nan,
+        *_mean_max_rms(d[valid]),
         frozen(d.reshape(grid_ny, grid_nx)), frozen(gu), frozen(gv), float(np.mean(valid)),
         fit_rotation, float(np.degrees(rotation_angle_rad(R))),
     )
@@ -208,11 +212,8 @@ def mrcal_projection_diff(cam_a, cam_b, *, gridn_width: int = 60, gridn_height: 
     q1[ok] = np.asarray(cam_b.project(v0[ok] @ R.T), float)
     d = np.linalg.norm(q1 - q0, axis=1)
     valid = np.isfinite(d)
-    dv = d[valid]
-    nan = float("nan")
     return MrcalProjectionDiffResult(
-        float(np.mean(dv)) if len(dv) else nan, float(np.max(dv)) if len(dv) else nan,
-        float(np.sqrt(np.mean(dv**2))) if len(dv) else nan, frozen(d.reshape(gridn_height, gridn_width)),
+        *_mean_max_rms(d[valid]), frozen(d.reshape(gridn_height, gridn_width)),
         frozen(gu), frozen(gv), float(np.mean(valid)), bool(intrinsics_only),
         float(np.degrees(rotation_angle_rad(R))), center, radius, n_focus,
     )
