@@ -69,12 +69,12 @@ def _rays(cam, uv: np.ndarray) -> np.ndarray:
     return np.asarray(cam.unproject(uv), dtype=np.float64)
 
 
-
 def _mean_max_rms(d: np.ndarray) -> tuple[float, float, float]:
     """(mean, max, RMS) of the finite differences d (px); NaN each when there are none."""
     if not len(d):
         return float("nan"), float("nan"), float("nan")
     return float(np.mean(d)), float(np.max(d)), float(np.sqrt(np.mean(d**2)))
+
 
 def projection_difference(cam_gt, cam_est, *, grid_nx: int = 60, grid_ny: int = 40,
                           fit_rotation: bool = False) -> ProjectionDiffResult:
