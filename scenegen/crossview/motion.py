@@ -7,19 +7,20 @@ then b's single camera model projects P_b (:func:`scenegen.crossview.corresponde
 and the ray cast of b's scene decides its state: VISIBLE, OCCLUDED, OUT_OF_FRAME, as for the
 static correspondences. A point whose object does not exist at b (outside its ``visible_s``) is
 OCCLUDED wherever it projects into b's image. Scene flow is ``P_b - P_a`` in the world frame.
+Through a rolling shutter (:func:`frame_motion`), P_a is where the point was when a's row saw it
+and P_b where it is when the row of b that images it is exposed (:mod:`scenegen.crossview.frames`).
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 
 import numpy as np
 
 from scenegen.crossview.correspondence import correspond
+from scenegen.crossview.frames import FrameGeometry, Poses, image, moving_ids, to_object
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE, Correspondence
 from scenegen.dataset.sequence import MotionTruth
 from scenegen.geometry.pose import Rigid3
-
-Poses = Mapping[int, tuple[Rigid3, bool]]  # object id -> (world_from_object, present)
 
 
 def _apply(T: Rigid3, P: np.ndarray) -> np.ndarray:
@@ -61,3 +62,25 @@ def moved_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: 
     state = c.state.copy()
     state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
     return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)
+
+
+def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: FrameGeometry,
+                 rows_a=None) -> MotionTruth:
+    """Motion truth of a's truth points (H, W, 3) (float64, NaN = no surface) on objects (H, W) at
+    frame b, either frame through a rolling shutter (a's points at the times of their rows in a:
+    ``rows_a`` (H * W,), by default each pixel's own row)."""
+    P = np.asarray(points_world_a, np.float64)
+    H, W, _ = P.shape
+    if frame_a.rolling is None and frame_b.rolling is None:
+        return moved_correspondence(P, object_ids_a, frame_a.poses, frame_b.poses, frame_b.camera,
+                                    frame_b.cam_from_world, frame_b.visible_fn)
+    movers = moving_ids([frame_a, frame_b])
+    if frame_a.rolling is None:
+        rows_a = None
+    elif rows_a is None:
+        rows_a = np.repeat(np.arange(H, dtype=np.float64), W)
+    X = to_object(P.reshape(-1, 3), object_ids_a, frame_a, rows_a, movers)
+    im = image(X, object_ids_a, frame_b, movers)
+    c = im.correspondence
+    return MotionTruth(Correspondence(c.uv.reshape(H, W, 2), c.z.reshape(H, W), c.state.reshape(H, W)),
+                      im.points_world.reshape(H, W, 3) - P)

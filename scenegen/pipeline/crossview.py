@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from scenegen.crossview.correspondence import correspond, flow_field
+from scenegen.crossview.frames import FrameGeometry
+from scenegen.crossview.motion import frame_motion
 from scenegen.crossview.matches import MatchParams, label_real_matches, sift_matches, synthetic_matches
 from scenegen.crossview.targets import board_view_truth
 from scenegen.dataset.codecs import encode_exr, encode_flo, encode_json, encode_npy, read_png
@@ -46,7 +48,7 @@ from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
 from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.stereo import write_stereo_frame
-from scenegen.pipeline.view import view_truth
+from scenegen.pipeline.view import rolling_rows, view_truth, visibility_fn
 
 #: Spec geometry kinds that are planes in their object's z = 0 plane (normal +z): they get a
 #: homography per pair.
@@ -69,7 +71,9 @@ class _Context:
         self.spec, self.built, self.writer = spec, built, writer
         self.views = {v.name: v for v in views}
         self._points: dict = {}
+        self._ids: dict = {}
         self._corr: dict = {}
+        self._geometry: dict = {}
         self.files: list[str] = []
 
     def camera(self, name):
@@ -81,7 +85,19 @@ class _Context:
         if name not in self._points:
             t = view_truth(self.built, self.views[name], as_stored=True)  # the call (and kernel) of the stored truth
             self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
+            self._ids[name] = t["object_id"].copy()
         return self._points[name]
+
+    def geometry(self, name) -> FrameGeometry:
+        """View ``name`` as a frame: its objects' poses, camera and, through a rolling shutter
+        where something moves within the frame, its rows (:mod:`scenegen.crossview.frames`)."""
+        if name not in self._geometry:
+            v = self.views[name]
+            rows = rolling_rows(self.built, v)
+            poses = {o.object_id: (self.object_pose(o, name), True) for o in self.spec.objects}
+            self._geometry[name] = FrameGeometry(poses, self.built.cameras[v.camera], v.cam_from_world,
+                                                 visibility_fn(self.built, v, rows), rows)
+        return self._geometry[name]
 
     def at(self, name) -> None:
         """Move a sequence's objects to the view's time (a static scene: nothing to do)."""
@@ -98,8 +114,12 @@ class _Context:
         if (i, j) not in self._corr:
             cam_j, pose_j = self.camera(j)
             points = self.points(i)
-            self.at(j)  # j's scene casts the visibility (the same time as i's: checked at validation)
-            self._corr[(i, j)] = correspond(points, cam_j, pose_j, self.built.visible_from)
+            gi, gj = self.geometry(i), self.geometry(j)
+            if gi.rolling is None and gj.rolling is None:
+                self.at(j)  # j's scene casts the visibility (the same time as i's: checked at validation)
+                self._corr[(i, j)] = correspond(points, cam_j, pose_j, self.built.visible_from)
+            else:  # i's points at their rows' times, imaged by j's rows
+                self._corr[(i, j)] = frame_motion(points, self._ids[i], gi, gj).correspondence
         return self._corr[(i, j)]
 
     def write(self, rel: str, data: bytes) -> None:
@@ -149,9 +169,17 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
         pi, pj = sift_matches(read_png(root / view_paths(a)["image"]), read_png(root / view_paths(b)["image"]),
                               cfg.sift_ratio)
         ctx.at(a)
-        P = ctx.built.surface_points(cam_a, pose_a, pi)
-        ctx.at(b)
-        c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
+        ga, gb = ctx.geometry(a), ctx.geometry(b)
+        if ga.rolling is None and gb.rolling is None:
+            P, _ = ctx.built.surface_points(cam_a, pose_a, pi)
+            ctx.at(b)
+            c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
+        else:  # each keypoint's surface point at its row's time, imaged by b's rows
+            rows = ga.rolling
+            P, ids = ctx.built.surface_points(cam_a, pose_a, pi, rows=None if rows is None else rows.cam,
+                                              moves=rows.object_moves(pi[:, 1]) if rows and rows.objects else None)
+            ids = np.zeros(len(pi), np.uint32) if ids is None else ids
+            c = frame_motion(P.reshape(-1, 1, 3), ids.reshape(-1, 1), ga, gb, rows_a=pi[:, 1]).correspondence
         rows = label_real_matches(pi, pj, c.uv.reshape(-1, 2), c.state.ravel() == VISIBLE, cfg.sift_inlier_px)
         ctx.write(matches_path(a, b, "sift"), encode_npy(rows))
         inliers = int((rows[:, MATCH_COLUMNS.index("label")] == INLIER).sum())
@@ -207,7 +235,8 @@ def run_crossview(spec, views, built, writer, *, spp: int, seed: int,
             for name, (board, wfb) in built.boards.items():  # a moving board: moved with its object
                 obj = objects[name]
                 wfb_v = ctx.object_pose(obj, v.name) @ obj.transform.world_from_object.inverse() @ wfb
-                boards[name] = board_view_truth(board, wfb_v, cam, pose, built.visible_from)
+                boards[name] = board_view_truth(board, wfb_v, cam, pose, built.visible_from, ctx.geometry(v.name),
+                                                (obj.object_id, ctx.object_pose(obj, v.name)))
             ctx.write(view_targets_path(v.name), encode_json({"view": v.name, "boards": boards}))
             index["targets"].append(v.name)
             bar.advance()

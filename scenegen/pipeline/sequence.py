@@ -14,8 +14,9 @@ from collections import OrderedDict
 
 import numpy as np
 
-from scenegen.crossview.motion import moved_correspondence
-from scenegen.crossview.tracks import FrameGeometry, track_points
+from scenegen.crossview.frames import FrameGeometry
+from scenegen.crossview.motion import frame_motion
+from scenegen.crossview.tracks import track_points
 from scenegen.dataset.codecs import TrackSet, encode_exr, encode_flo, encode_json, encode_tracks
 from scenegen.dataset.crossview import STATE_NAMES
 from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
@@ -28,7 +29,7 @@ from scenegen.dataset.sequence import (
 )
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.pipeline.pairs import streams
-from scenegen.pipeline.view import rolling_shutter_rows, view_truth
+from scenegen.pipeline.view import rolling_rows, rolling_shutter_rows, view_truth, visibility_fn
 from scenegen.spec.timeline import Timeline
 
 
@@ -40,6 +41,7 @@ class SequenceTruth:
         self.timeline = Timeline(spec)
         self._frames: OrderedDict = OrderedDict()  # the last keep_frames frames' points (bounded memory)
         self.keep_frames = max(2, int(keep_frames))
+        self._geometry: dict = {}
 
     def frame(self, view) -> tuple[np.ndarray, np.ndarray]:
         """((H, W, 3) float64 world points, NaN = no surface; (H, W) uint32 object ids) of a view."""
@@ -66,16 +68,17 @@ class SequenceTruth:
     def poses(self, view):
         return self.timeline.poses_by_id(view.time_s)
 
-    def visible_fn(self, view):
-        def visible(center, points):
-            self.built.set_time(view.time_s)
-            return self.built.visible_from(center, points)
-        return visible
+    def geometry(self, view) -> FrameGeometry:
+        """The frame as the truth across time sees it (its rolling shutter's rows included)."""
+        if view.name not in self._geometry:
+            rows = rolling_rows(self.built, view)
+            self._geometry[view.name] = FrameGeometry(self.poses(view), self.built.cameras[view.camera],
+                                                      view.cam_from_world, visibility_fn(self.built, view, rows), rows)
+        return self._geometry[view.name]
 
     def motion(self, a, b):
         P, ids = self.frame(a)
-        return moved_correspondence(P, ids, self.poses(a), self.poses(b), self.built.cameras[b.camera],
-                                    b.cam_from_world, self.visible_fn(b))
+        return frame_motion(P, ids, self.geometry(a), self.geometry(b))
 
 
 def stream_name(vs_prefix: str, member: str | None) -> str:
@@ -99,8 +102,7 @@ def query_pixels(ids: np.ndarray, valid: np.ndarray, animated_ids, count: int, s
 
 def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
     """The tracks of one stream (frames ``vs`` in order)."""
-    frames = [FrameGeometry(st.poses(v), st.built.cameras[v.camera], v.cam_from_world, st.visible_fn(v))
-              for v in vs]
+    frames = [st.geometry(v) for v in vs]
     animated = {o.object_id for o in st.spec.objects if o.animation is not None}
     qs = [q for q in cfg.query_frames if q < len(vs)]
     queries, groups = [], []
@@ -108,7 +110,7 @@ def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
         P, ids = st.frame(vs[q])
         n = cfg.count // len(qs) + (1 if i < cfg.count % len(qs) else 0)
         px = query_pixels(ids, np.isfinite(P[..., 0]), animated, n, hashed_seed32(cfg.seed, name, q))
-        groups.append((P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.poses(vs[q])))
+        groups.append((P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.geometry(vs[q]), px[:, 1]))
         queries.append(np.column_stack([np.full(len(px), q), px[:, 1], px[:, 0]]))
     xy, occ, oof = track_points(groups, frames)  # each frame's scene cast once for every query
     cam = st.built.cameras[vs[0].camera]

@@ -9,9 +9,11 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.geometry.color import srgb_image
-from scenegen.geometry.optics import PathMotion, motion_to_dict, row_poses
+from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict, row_poses
+from scenegen.geometry.rolling import RollingRows, RowPoses
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.imaging.stage import apply_imaging
+from scenegen.spec.timeline import poses_within_frame
 
 
 def view_seed(seed: int, view_index: int) -> int:
@@ -27,13 +29,46 @@ def rolling_shutter_rows(built, view):
     return row_poses(view.cam_from_world, view.motion, shutter, built.cameras[view.camera].height)
 
 
+def rolling_rows(built, view) -> RollingRows | None:
+    """The camera's and the moving objects' poses at every row node of a rolling-shutter view in
+    which something moves within the frame (:mod:`scenegen.geometry.rolling`), else None."""
+    shutter = getattr(built.optics.get(view.camera), "shutter", None)
+    camera_moves = view.motion is not None and not view.motion.is_static
+    if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
+        return None
+    H = built.cameras[view.camera].height
+    nodes = np.arange(-1, H + 1, dtype=np.float64)
+    taus = shutter.row_time_s(nodes, H)
+    cam = RowPoses.over_rows(
+        lambda v: cam_from_world_at(view.cam_from_world, view.motion, float(taus[int(v) + 1])).inverse(), H)
+    objects, present = {}, {}
+    if built.movers:
+        for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
+            objects[oid], present[oid] = RowPoses(R, t, -1.0), p
+    return RollingRows(cam, objects, present)
+
+
+def visibility_fn(built, view, rows: RollingRows | None):
+    """The visibility cast of a frame (:class:`scenegen.crossview.frames.FrameGeometry`): in the
+    scene at the view's time; with a rolling shutter's ``rows``, from each point's row centre
+    with the moving objects at that row's time."""
+    def visible(centres, points, point_rows=None):
+        built.set_time(getattr(view, "time_s", None))
+        moves = rows.object_moves(point_rows) if rows is not None and rows.objects else None
+        return built.visible_from(centres, points, moves=moves)
+    return visible
+
+
 def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
-    """The truth pass of a view: per-row poses for a rolling shutter; range and depth_z in
-    float64, or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``.
-    A sequence's frame is cast at its time (the scene's objects moved there)."""
+    """The truth pass of a view: per-row poses for a rolling shutter (the camera's, and the moving
+    objects' where each row's rays meet them at the row's time); range and depth_z in float64,
+    or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``. A
+    sequence's frame is cast at its time (the scene's objects moved there)."""
     built.set_time(getattr(view, "time_s", None))
+    rows = rolling_rows(built, view) if built.movers else None
+    moves = rows.object_moves() if rows is not None and rows.objects else None
     return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view),
-                       as_stored=as_stored)
+                       as_stored=as_stored, row_moves=moves)
 
 
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):

@@ -16,6 +16,7 @@ import numpy as np
 from scenegen.dataset.crossview import OCCLUSION_REL_TOL
 from scenegen.render.alpha import opaque_intersect
 from scenegen.render.arrays import to_jit
+from scenegen.render.timed import first_hit, timed_first_hit, upload_moves
 
 
 def first_hit_distance(scene, origin_world, directions_world, alpha_masked: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -57,25 +58,39 @@ def _first_hits_vectorised(scene, o, d, alpha_masked: bool = False) -> np.ndarra
 
 
 def visible_from(scene, center_world, points_world, rel_tol: float = OCCLUSION_REL_TOL,
-                 alpha_masked: bool = False) -> np.ndarray:
+                 alpha_masked: bool = False, timed=None) -> np.ndarray:
     """(N,) bool: nothing lies between ``center_world`` and each point (N, 3) (float64, metres),
     up to ``rel_tol`` of the distance (see :data:`OCCLUSION_REL_TOL`). NaN points -> False.
-    ``alpha_masked``: alpha-mask holes do not occlude (:mod:`scenegen.render.alpha`)."""
+    ``center_world``: one centre (3,), or one per point (N, 3) (a rolling shutter's rows).
+    ``alpha_masked``: alpha-mask holes do not occlude (:mod:`scenegen.render.alpha`).
+    ``timed``: (:class:`scenegen.render.timed.TimedScenes`, {object id: ((N, 3, 3) R, (N, 3) t
+    world_from_object, (N,) present)}): each ray meets the moving objects where they are at its
+    point's time; ``scene`` is not used."""
     P = np.asarray(points_world, np.float64)
     C = np.asarray(center_world, np.float64)
     ok = np.isfinite(P[:, 0]) & np.isfinite(P[:, 1]) & np.isfinite(P[:, 2])
     out = np.zeros(len(P), bool)
     if not ok.any():
         return out
-    if ok.all() and not mi.variant().startswith("scalar") and not alpha_masked:  # the usual case: no copy
+    per_point = C.ndim == 2
+    scalar = mi.variant().startswith("scalar")
+    if ok.all() and not scalar and not alpha_masked and not per_point and timed is None:  # the usual case: no copy
         return _visible_vectorised(scene, C, P, rel_tol)
-    if mi.variant().startswith("scalar") or alpha_masked:
+    sel = np.flatnonzero(ok)
+    if per_point or timed is not None:
+        if scalar:
+            raise NotImplementedError("rolling-shutter visibility needs a vectorised variant (llvm_ad_rgb / cuda_ad_rgb)")
+        Cs = C[sel] if per_point else np.broadcast_to(C, (len(sel), 3))
+        moves = None if timed is None else {k: (R[sel], t[sel], p[sel]) for k, (R, t, p) in timed[1].items()}
+        out[sel] = _visible_rays(scene, Cs, P[sel], rel_tol, alpha_masked, None if timed is None else (timed[0], moves))
+        return out
+    if scalar or alpha_masked:
         v = P[ok] - C
         dist = np.linalg.norm(v, axis=1)
         t, _ = first_hit_distance(scene, C, v / dist[:, None], alpha_masked)
-        out[np.flatnonzero(ok)] = t >= dist * (1.0 - rel_tol)
+        out[sel] = t >= dist * (1.0 - rel_tol)
         return out
-    out[np.flatnonzero(ok)] = _visible_vectorised(scene, C, P[ok], rel_tol)
+    out[sel] = _visible_vectorised(scene, C, P[ok], rel_tol)
     return out
 
 
@@ -97,16 +112,67 @@ def _visible_vectorised(scene, C, P, rel_tol: float) -> np.ndarray:
     return visible.numpy().copy()
 
 
-def surface_points(scene, camera, cam_from_world, uv, alpha_masked: bool = False) -> np.ndarray:
-    """(N, 3) float64 world points of the surface seen through sub-pixel positions (N, 2) of a
-    camera (its full model, float64 unprojection as in the truth pass); NaN where nothing is hit."""
+def _visible_rays(scene, C, P, rel_tol: float, alpha_masked: bool, timed) -> np.ndarray:
+    """The visibility test of rays with their own origins ``C`` (M, 3) towards ``P`` (M, 3), in
+    ``scene`` or, with ``timed`` = (TimedScenes, per-ray moves), with the moving objects where
+    each ray's moves put them."""
+    v = P - C
+    dist = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    t, _ = _cast_rays(scene, C, v / dist[:, None], alpha_masked, timed)
+    return t >= dist * (1.0 - rel_tol)
+
+
+def surface_points(scene, camera, cam_from_world, uv, alpha_masked: bool = False, rows=None,
+                   timed=None) -> tuple[np.ndarray, np.ndarray | None]:
+    """((N, 3) float64 world points of the surface seen through sub-pixel positions (N, 2) of a
+    camera (its full model, float64 unprojection as in the truth pass), NaN where nothing is hit;
+    (N,) uint32 object ids of those surfaces, or None). ``rows`` (a rolling shutter): the
+    camera's world_from_cam per row (:class:`scenegen.geometry.rolling.RowPoses`), each ray
+    cast from its own row's pose; ``timed`` = (TimedScenes, {object id: ((N, 3, 3) R, (N, 3) t
+    world_from_object, (N,) present)}): the moving objects where they are at each ray's row
+    (then the ids come back)."""
     uv = np.asarray(uv, np.float64)
-    world_from_cam = cam_from_world.inverse()
     d_cam = camera.unproject_unit(uv)
     out = np.full((len(uv), 3), np.nan)
+    ids = None if timed is None else np.zeros(len(uv), np.uint32)
     ok = np.all(np.isfinite(d_cam), axis=1)
-    if ok.any():
-        d_world = world_from_cam.rotate(d_cam[ok])
-        _, pts = first_hit_distance(scene, world_from_cam.t, d_world, alpha_masked)
+    if not ok.any():
+        return out, ids
+    if rows is None and timed is None:
+        world_from_cam = cam_from_world.inverse()
+        _, pts = first_hit_distance(scene, world_from_cam.t, world_from_cam.rotate(d_cam[ok]), alpha_masked)
         out[ok] = pts
-    return out
+        return out, ids
+    sel = np.flatnonzero(ok)
+    if rows is not None:
+        R, C = rows.at(uv[sel, 1])
+        d = np.einsum("nij,nj->ni", R, d_cam[sel])
+    else:
+        wfc = cam_from_world.inverse()
+        C, d = np.broadcast_to(wfc.t, (len(sel), 3)), wfc.rotate(d_cam[sel])
+    moves = None if timed is None else (timed[0], {k: (R_[sel], t_[sel], p_[sel]) for k, (R_, t_, p_) in timed[1].items()})
+    t, oid = _cast_rays(scene, C, d, alpha_masked, moves)
+    hit = np.isfinite(t)
+    out[sel[hit]] = C[hit] + t[hit, None] * d[hit]
+    if ids is not None:
+        ids[sel] = oid
+    return out, ids
+
+
+def _cast_rays(scene, C, d, alpha_masked: bool, timed):
+    """((M,) float64 first-hit distances (inf: miss), (M,) uint32 object ids or None) of rays
+    from origins ``C`` (M, 3) along unit ``d`` (M, 3), in ``scene`` or the timed scenes."""
+    c = mi.Vector3d(*[to_jit(mi.Float64, C[:, i], np.float64) for i in range(3)])
+    dj = mi.Vector3d(*[to_jit(mi.Float64, d[:, i], np.float64) for i in range(3)])
+    if timed is None:
+        t, hit, *_ = first_hit(scene, mi.Ray3f(mi.Point3f(mi.Vector3f(c)), mi.Vector3f(dj)), alpha_masked,
+                               coherent=False)
+        t = dr.select(hit, mi.Float64(t), dr.inf)
+        dr.eval(t)
+        return t.numpy().copy(), None
+    ts, moves = timed
+    t, hit, _, _, sid = timed_first_hit(ts, c, dj, upload_moves(ts, moves), alpha_masked, coherent=False)
+    t = dr.select(hit, mi.Float64(t), dr.inf)
+    oid = dr.select(hit, dr.gather(mi.UInt32, ts.id_tables[0], sid), 0)
+    dr.eval(t, oid)
+    return t.numpy().copy(), oid.numpy().copy()

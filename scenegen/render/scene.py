@@ -18,10 +18,11 @@ from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
 from scenegen.render.objects import moving_entry, object_entries
+from scenegen.render.timed import build_timed
 from scenegen.render.truth import camera_rays, prepare_camera, shape_id_table, truth_pass
 from scenegen.spec import model as m
 from scenegen.spec.assets_check import located
-from scenegen.spec.timeline import Timeline, is_animated
+from scenegen.spec.timeline import Timeline, is_animated, moves_within_frame
 
 
 @dataclass
@@ -49,6 +50,10 @@ class LoadedScene:
     animated: list = field(default_factory=list)  # objects placed per time (animate.Animated)
     time_s: float | None = None  # the clock time the animated objects are at (None: frame 0)
     animated_params: object = None  # mi.traverse of the scene, made on the first placement
+    scene_entries: dict = field(default_factory=dict)  # the scene dict's shapes and emitters (no sensors)
+    entry_ids: tuple = ({}, {})  # (dict key -> object id, dict key -> instance id)
+    movers: dict = field(default_factory=dict)  # object id -> spec object that moves within a frame
+    timed_scenes: object = None  # render.timed.TimedScenes, made on first use (:meth:`timed`)
 
     @property
     def variant(self) -> str:
@@ -76,23 +81,51 @@ class LoadedScene:
         return render_ideal(self, sensor_camera_name, camera, cam_from_world, spp=spp, seed=seed,
                             light_scales=light_scales)
 
-    def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False) -> dict[str, np.ndarray]:
-        """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`)."""
+    def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False,
+              row_moves=None) -> dict[str, np.ndarray]:
+        """Per-pixel truth of a camera at a pose (:func:`scenegen.render.truth.truth_pass`);
+        ``row_moves`` {object id: ((H, 3, 3) R, (H, 3) t world_from_object, (H,) present)}: the
+        moving objects where they are at each row's time (rolling shutter)."""
+        timed = None if row_moves is None else (self.timed(), row_moves)
         return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored,
-                          alpha_masked=self.alpha_masked)
+                          alpha_masked=self.alpha_masked, timed=timed)
+
+    def timed(self):
+        """The still world and one scene per moving object (:mod:`scenegen.render.timed`),
+        built on the first call."""
+        if self.timed_scenes is None:
+            movers = {oid: object_entries(obj, object_key(obj), _scratch()) for oid, obj in self.movers.items()}
+            keys = {k for entries in movers.values() for k in entries}
+            refs = {oid: obj.transform.world_from_object for oid, obj in self.movers.items()}
+            self.timed_scenes = build_timed({k: v for k, v in self.scene_entries.items() if k not in keys},
+                                            movers, refs, *self.entry_ids)
+        return self.timed_scenes
 
     def camera_rays(self, camera) -> np.ndarray:
         """(H*W, 3) float64 unit rays of the camera's pixel centres, row-major, as the truth pass
         casts them (:func:`scenegen.render.truth.camera_rays`, read-only)."""
         return camera_rays(camera)
 
-    def visible_from(self, center_world, points_world) -> np.ndarray:
-        """(N,) bool visibility of world points from a centre (:func:`scenegen.render.raycast.visible_from`)."""
-        return raycast.visible_from(self.scene, center_world, points_world, alpha_masked=self.alpha_masked)
+    def visible_from(self, center_world, points_world, moves=None) -> np.ndarray:
+        """(N,) bool visibility of world points from a centre (3,), or each from its own centre
+        (N, 3) (:func:`scenegen.render.raycast.visible_from`); ``moves`` {object id: ((N, 3, 3)
+        R, (N, 3) t world_from_object, (N,) present)}: the moving objects where they are when each
+        point is seen (rolling shutter)."""
+        timed = None if moves is None else (self.timed(), moves)
+        return raycast.visible_from(self.scene, center_world, points_world, alpha_masked=self.alpha_masked,
+                                    timed=timed)
 
-    def surface_points(self, camera, cam_from_world: Rigid3, uv) -> np.ndarray:
-        """(N, 3) world points seen through sub-pixel positions (:func:`scenegen.render.raycast.surface_points`)."""
-        return raycast.surface_points(self.scene, camera, cam_from_world, uv, self.alpha_masked)
+    def surface_points(self, camera, cam_from_world: Rigid3, uv, rows=None, moves=None):
+        """((N, 3) world points seen through sub-pixel positions, (N,) their object ids or None)
+        (:func:`scenegen.render.raycast.surface_points`; ``rows``: a rolling shutter's
+        world_from_cam per row, ``moves``: the moving objects at the positions' rows)."""
+        timed = None if moves is None else (self.timed(), moves)
+        return raycast.surface_points(self.scene, camera, cam_from_world, uv, self.alpha_masked, rows, timed)
+
+
+def _scratch() -> LoadedScene:
+    """A throwaway record for building a second copy of an object's shapes."""
+    return LoadedScene(scene=None, sensors={}, cameras={}, meshes_world={}, id_tables=())
 
 
 def object_key(obj) -> str:
@@ -118,11 +151,13 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
                 built.animated.append(animated_entry(key, obj, entry, mesh))
             object_ids[key] = obj.object_id
             instance_ids[key] = obj.instance_id
+        if moves_within_frame(obj):
+            built.movers[obj.object_id] = obj
         built.objects.append({"name": obj.name, "object_id": obj.object_id, "instance_id": obj.instance_id,
                               "kind": type(obj.geometry).__name__.lower()})
     for i, light in enumerate(spec.lights):
         d[light_key(i)] = light_entry(light)
-    if built.animated:
+    if built.movers:
         built.timeline = Timeline(spec)
     built.motion_subframes = spec.render.motion_subframes if built.moving or built.animated else 1
     for name, cam_spec in spec.cameras.items():
@@ -132,6 +167,9 @@ def build_scene(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) ->
         shutter = getattr(cam_spec.optics, "shutter", None)
         timed = shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
         d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=spp, sampler=sampler, name=name, timed=timed)
+    # what the timed casts' still scene shares (the Mitsuba shapes themselves), no sensors
+    built.scene_entries = {k: v for k, v in d.items() if k not in ("type", "integrator") and not k.startswith("sensor_")}
+    built.entry_ids = (object_ids, instance_ids)
     built.scene = mi.load_dict(d)
     built.emitters = loaded_emitters(built.scene, spec.lights)
     built.light_scales = (1.0,) * len(spec.lights)

@@ -51,14 +51,18 @@ class ScenegenSensor(mi.Sensor):
         self.lens = None  # (aperture radius m, focus distance m), opaque
         self.time_model = None  # see set_camera
         self.fold_mask = False
+        self.time_bin = None  # (lo, hi) seconds: see set_camera
 
     def set_camera(self, camera: Camera, cam_from_world: Rigid3, optics=None, motion=None,
-                   time_window=(0.0, 1.0)) -> None:
+                   time_window=(0.0, 1.0), time_bin=None) -> None:
         """Use ``camera`` at pose ``cam_from_world`` (the mid-exposure pose).
 
         ``optics`` (:class:`scenegen.geometry.optics.Optics`) adds a thin lens and a shutter; ``motion``
         (:class:`scenegen.geometry.optics.Motion`, camera-frame velocities) moves the camera over the
         exposure. ``time_window`` is the part of the exposure this render covers (sub-frames).
+        ``time_bin`` (lo, hi), seconds from mid-exposure: only samples whose time (their row's
+        time plus their place in the exposure) falls in [lo, hi) count; the others get weight 0
+        and a ray that hits nothing (rolling-shutter sub-frames, :func:`scenegen.render.frames.render_view`).
         The film must already have the camera's size.
         """
         film_size = tuple(int(s) for s in self.film().size())
@@ -102,11 +106,16 @@ class ScenegenSensor(mi.Sensor):
                 t0=opaque(time_window[0]), t1=opaque(time_window[1]), exposure=opaque(exposure),
                 readout=opaque(readout), speed=opaque(speed), rotating=speed > 0,
                 axis=[opaque(a) for a in axis], v=[opaque(c) for c in motion.linear_velocity_mps])
+        elif time_bin is not None:  # a still camera: only the samples' times
+            self.time_model = SimpleNamespace(t0=opaque(time_window[0]), t1=opaque(time_window[1]),
+                                              exposure=opaque(exposure), readout=opaque(readout), still=True)
         else:
             self.time_model = None
+        self.time_bin = None if time_bin is None else tuple(opaque(x) for x in time_bin)
 
     def camera_frame_rays(self, sample2, sample3, time):
-        """(origins, unit directions) in the OpenCV camera frame at mid-exposure pose.
+        """(origins, unit directions, the sample's time in seconds from mid-exposure or None) in
+        the OpenCV camera frame at mid-exposure pose.
 
         The chief ray comes from our camera model; a thin lens moves the origin over the aperture
         and aims at the chief ray's point on the focus plane (depth z = focus distance); camera
@@ -124,20 +133,23 @@ class ScenegenSensor(mi.Sensor):
             o = mi.Vector3f(a.x, a.y, 0.0)
             d = dr.normalize(d * (focus / dz) - o)
         tm = self.time_model
-        if tm is not None:
-            # seconds from mid-exposure: position in the (sub-frame) window, plus the row's offset
-            tau = (tm.t0 + time * (tm.t1 - tm.t0) - 0.5) * tm.exposure
-            tau = tau + tm.readout * (v / max(self.height - 1, 1) - 0.5)  # = optics.Shutter.row_time_s(v)
-            if hasattr(tm, "rotvec"):
-                return self._along_path(tm, tau, o, d)
-            if tm.rotating:  # Rodrigues: world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau]
-                k = mi.Vector3f(*tm.axis)
-                ang = tm.speed * tau
-                c, s = dr.cos(ang), dr.sin(ang)
-                rot = lambda x: x * c + dr.cross(k, x) * s + k * dr.dot(k, x) * (1.0 - c)
-                o, d = rot(o), rot(d)
-            o = o + mi.Vector3f(*tm.v) * tau
-        return o, d
+        if tm is None:
+            return o, d, None
+        # seconds from mid-exposure: position in the (sub-frame) window, plus the row's offset
+        tau = (tm.t0 + time * (tm.t1 - tm.t0) - 0.5) * tm.exposure
+        tau = tau + tm.readout * (v / max(self.height - 1, 1) - 0.5)  # = optics.Shutter.row_time_s(v)
+        if hasattr(tm, "rotvec"):
+            return (*self._along_path(tm, tau, o, d), tau)
+        if hasattr(tm, "still"):
+            return o, d, tau
+        if tm.rotating:  # Rodrigues: world_from_cam(tau) = world_from_cam @ [exp(w tau) | v tau]
+            k = mi.Vector3f(*tm.axis)
+            ang = tm.speed * tau
+            c, s = dr.cos(ang), dr.sin(ang)
+            rot = lambda x: x * c + dr.cross(k, x) * s + k * dr.dot(k, x) * (1.0 - c)
+            o, d = rot(o), rot(d)
+        o = o + mi.Vector3f(*tm.v) * tau
+        return o, d, tau
 
     @staticmethod
     def _along_path(tm, tau, o, d):
@@ -156,7 +168,7 @@ class ScenegenSensor(mi.Sensor):
 
     def sample_ray(self, time, sample1, sample2, sample3, active=True):
         wavelengths, wav_weight = self.sample_wavelengths(dr.zeros(mi.SurfaceInteraction3f), sample1, active)
-        o, d = self.camera_frame_rays(sample2, sample3, time)
+        o, d, tau = self.camera_frame_rays(sample2, sample3, time)
         R, C = self.R_world_from_cam, self.center_world
         rot = lambda x: mi.Vector3f(R[0][0] * x.x + R[0][1] * x.y + R[0][2] * x.z,
                                     R[1][0] * x.x + R[1][1] * x.y + R[1][2] * x.z,
@@ -167,7 +179,13 @@ class ScenegenSensor(mi.Sensor):
             o = dr.select(ok, o, mi.Vector3f(0.0))
             wav_weight = dr.select(ok, wav_weight, 0.0)
         origin = mi.Point3f(rot(o) + mi.Vector3f(*C))
-        return mi.Ray3f(origin, rot(d), time, wavelengths), wav_weight
+        ray = mi.Ray3f(origin, rot(d), time, wavelengths)
+        if self.time_bin is not None:  # a sample outside this sub-frame's time: no weight, no hit
+            lo, hi = self.time_bin
+            inside = (tau >= lo) & (tau < hi)
+            wav_weight = dr.select(inside, wav_weight, 0.0)
+            ray.maxt = dr.select(inside, ray.maxt, 0.0)
+        return ray, wav_weight
 
     def sample_ray_differential(self, time, sample1, sample2, sample3, active=True):
         ray, weight = self.sample_ray(time, sample1, sample2, sample3, active)

@@ -33,8 +33,8 @@ from scenegen.assets.cache import cached_arrays
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.pose import Rigid3
-from scenegen.render.alpha import opaque_intersect
 from scenegen.render.arrays import to_jit
+from scenegen.render.timed import casting_flags, first_hit, timed_first_hit, upload_moves
 
 
 @functools.lru_cache(maxsize=16)
@@ -89,7 +89,7 @@ def _matvec(R, v):
 
 def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
                row_poses: list[Rigid3] | None = None, as_stored: bool = False,
-               alpha_masked: bool = False) -> dict[str, np.ndarray]:
+               alpha_masked: bool = False, timed=None) -> dict[str, np.ndarray]:
     """All per-pixel truth for one view; arrays are (H, W[, C]). See the module docstring.
 
     ``row_poses`` (rolling shutter): one ``cam_from_world`` per image row; each row's rays start
@@ -97,9 +97,15 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
     frame. Without it every row uses ``cam_from_world``. ``as_stored``: range and depth_z in
     float32 (the float64 values rounded to nearest, bit for bit what storing them gives).
     ``alpha_masked``: the scene has alpha masks; rays pass through their holes
-    (:mod:`scenegen.render.alpha`).
+    (:mod:`scenegen.render.alpha`). ``timed`` (rolling shutter with moving objects): a pair
+    (:class:`scenegen.render.timed.TimedScenes`, {object id: ((H, 3, 3) R, (H, 3) t
+    world_from_object, (H,) present) per row}): each row's rays meet the objects where they are at
+    the row's time (:mod:`scenegen.render.timed`), ``scene`` and ``id_tables`` are not used.
     """
     if mi.variant().startswith("scalar"):
+        if timed is not None:
+            raise NotImplementedError("rolling-shutter truth with moving objects needs a vectorised variant "
+                                      "(llvm_ad_rgb / cuda_ad_rgb)")
         if alpha_masked:
             raise ValueError("alpha masks need a vectorised Mitsuba variant for their truth (llvm_ad_rgb / cuda_ad_rgb)")
         if row_poses is not None:
@@ -128,24 +134,24 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
 
     d_cam = _camera_rays_dr(camera)
     d_world = _matvec(Rwc, d_cam)
-    ray = mi.Ray3f(mi.Point3f(mi.Vector3f(C)), mi.Vector3f(d_world))
-    # only what the outputs need: position, uv and the shading normal (no dP/dUV derivatives)
-    if alpha_masked:
-        si, t_hit = opaque_intersect(scene, ray, _flags(), coherent=True)
-    else:
-        si = scene.ray_intersect(ray, ray_flags=_flags(), coherent=True)
-        t_hit = si.t
-    hit = si.is_valid()
+    if timed is None:
+        ray = mi.Ray3f(mi.Point3f(mi.Vector3f(C)), mi.Vector3f(d_world))
+        t_hit, hit, n_hit, uv_hit, sid = first_hit(scene, ray, alpha_masked, coherent=True)
+    else:  # each row's rays meet the moving objects where they are at the row's time
+        ts, row_moves = timed
+        row = dr.arange(mi.UInt32, H * W) // W
+        t_hit, hit, n_hit, uv_hit, sid = timed_first_hit(ts, C, d_world, upload_moves(ts, row_moves, row),
+                                                         alpha_masked, coherent=True)
+        id_tables = ts.id_tables
     nan64 = dr.nan if hasattr(dr, "nan") else math.nan
     t = dr.select(hit, mi.Float64(t_hit), dr.inf)
     t_pts = dr.select(hit, mi.Float64(t_hit), nan64)  # NaN points for misses
     points_cam = d_cam * t_pts
     points_world = C + d_world * t_pts
-    n_world = mi.Vector3d(si.sh_frame.n)
+    n_world = mi.Vector3d(n_hit)
     n_world = dr.select(hit, dr.normalize(n_world), nan64)
     n_cam = _matvec(Rcw, n_world)
-    uv = dr.select(hit, mi.Vector2f(si.uv), math.nan)
-    sid = dr.reinterpret_array(mi.UInt32, si.shape)
+    uv = dr.select(hit, mi.Vector2f(uv_hit), math.nan)
     obj_table, inst_table = id_tables
     sid = dr.select(hit, sid, 0)
     obj = dr.select(hit, dr.gather(mi.UInt32, obj_table, sid), 0)
@@ -199,11 +205,6 @@ def _planar(vector, n: int):
     return buf
 
 
-def _flags():
-    """Only what the truth needs: position, uv and the shading normal (no dP/dUV derivatives)."""
-    return mi.RayFlags.Minimal | mi.RayFlags.UV | mi.RayFlags.ShadingFrame
-
-
 def _truth_pass_scalar(scene, camera: Camera, cam_from_world: Rigid3, id_tables) -> dict[str, np.ndarray]:
     """The same truth in the ``scalar_rgb`` fallback (no working libLLVM): one Python call per
     ray, derived in float64 numpy. Slow (seconds per VGA frame), for correctness only."""
@@ -236,7 +237,7 @@ def _cast_rays_scalar(scene, origins_world, dirs_world, id_tables) -> dict[str, 
     o = origins_world.astype(np.float32)
     for i, d in enumerate(dirs_world.astype(np.float32)):
         oi = o[0] if len(o) == 1 else o[i]
-        si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*oi.tolist()), mi.Vector3f(*d.tolist())), _flags(), True)
+        si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*oi.tolist()), mi.Vector3f(*d.tolist())), casting_flags(), True)
         if not si.is_valid():
             continue
         sid = si.shape.id()

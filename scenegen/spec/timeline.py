@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
+from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.trajectory import MotionState
 
@@ -94,3 +97,32 @@ class Timeline:
         """{object id: (world_from_object, present)} at ``t_s``."""
         s = self.states(t_s)
         return {o.object_id: (s[o.name].world_from_object, s[o.name].present) for o in self.objects}
+
+
+def moves_within_frame(obj) -> bool:
+    """The object moves during one frame's exposure or readout: a sequence's animated object, or
+    an object with a (non-zero) ``motion``."""
+    motion = getattr(obj, "motion", None)
+    return is_animated(obj) or (motion is not None and not motion.is_static)
+
+
+def poses_within_frame(timeline: Timeline, time_s: float | None, taus_s) -> dict[int, tuple]:
+    """{object id: ((n, 3, 3) R, (n, 3) t of world_from_object, (n,) bool present)} of every
+    object that moves within a frame (:func:`moves_within_frame`), at ``taus_s`` (n,) seconds from
+    the frame's time ``time_s`` (None: a static spec's view, whose ``motion`` objects move about
+    their ``transform`` from mid-exposure)."""
+    taus = np.asarray(taus_s, np.float64).reshape(-1)
+    movers = [o for o in timeline.objects if moves_within_frame(o)]
+    out = {o.object_id: (np.empty((len(taus), 3, 3)), np.empty((len(taus), 3)), np.ones(len(taus), bool))
+           for o in movers}
+    for k, tau in enumerate(taus):
+        states = timeline.states(time_s + tau) if time_s is not None and any(map(is_animated, movers)) else {}
+        for o in movers:
+            R, t, present = out[o.object_id]
+            if is_animated(o):
+                st = states[o.name]
+                pose, present[k] = st.world_from_object, st.present
+            else:
+                pose = world_from_object_at(o.transform.world_from_object, o.motion, float(tau))
+            R[k], t[k] = pose.R, pose.t
+    return out
