@@ -12,7 +12,7 @@ scene's flow step 3). Timed, interleaved per round:
   which are recomputed in the round (two truth passes included, as the sequence stage does);
 * ``pair_cached``: the same with the frames' truth points already at hand;
 * ``static``: the static cross-view correspondences of the same two views both ways
-  (:func:`scenegen.crossview.correspondence.correspond`, the scene left where it is): what the
+  (:meth:`scenegen.render.scene.LoadedScene.correspond`, the scene left where it is): what the
   pair would cost if nothing moved.
 
 The issue sets no bound. Printed ``TARGET`` lines: what moving objects add, pair_cached / static
@@ -38,9 +38,8 @@ def main(argv=None) -> int:
     ap.add_argument("--reps", type=int, default=5)
     args = ap.parse_args(argv)
 
-    from scenegen.crossview.correspondence import correspond
     from scenegen.pipeline.sequence import SequenceTruth
-    from scenegen.pipeline.view import view_truth
+    from scenegen.pipeline.view import correspond_points, view_truth
     from scenegen.render import load_scene
     from scenegen.spec import parse_spec, resolve_views
 
@@ -72,7 +71,7 @@ def main(argv=None) -> int:
     def static():
         t = time.perf_counter()
         for P, v in ((pa, b), (pb, a)):
-            correspond(P, built.cameras[v.camera], v.cam_from_world, built.visible_from)
+            correspond_points(built, P, built.cameras[v.camera], v.cam_from_world)
         return time.perf_counter() - t
 
     truth(), pair(False), static()  # warm: kernels, first-use costs

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.crossview.correspondence import finite_rows, project_points
+from scenegen.crossview.correspondence import correspond, finite_rows, project_points
 from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIBLE, Correspondence
 from scenegen.geometry.conventions import in_image
 from scenegen.geometry.pose import Rigid3
@@ -37,6 +37,15 @@ class FrameGeometry:
     cam_from_world: Rigid3  # at the frame's time (its middle row)
     visible_fn: Callable
     rolling: RollingRows | None = None
+    # (points (H, W, 3) world, camera, cam_from_world) -> Correspondence in this frame's scene, the
+    # definition of correspondence.correspond (e.g. in one kernel); None: correspond with visible_fn
+    correspond_fn: Callable | None = None
+
+    def correspond(self, points_world) -> Correspondence:
+        """Correspondences of world points (H, W, 3) in this frame at its time (global shutter)."""
+        if self.correspond_fn is not None:
+            return self.correspond_fn(points_world, self.camera, self.cam_from_world)
+        return correspond(points_world, self.camera, self.cam_from_world, self.visible_fn)
 
 
 @dataclass(frozen=True, eq=False)

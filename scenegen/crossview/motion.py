@@ -12,11 +12,9 @@ and P_b where it is when the row of b that images it is exposed (:mod:`scenegen.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 
 import numpy as np
 
-from scenegen.crossview.correspondence import correspond
 from scenegen.crossview.frames import FrameGeometry, Poses, image, moving_ids, to_object
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE, Correspondence
 from scenegen.dataset.sequence import MotionTruth
@@ -50,20 +48,6 @@ def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tup
     return out, present
 
 
-def moved_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: Poses, camera_b,
-                         cam_b_from_world: Rigid3,
-                         visible_fn_b: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> MotionTruth:
-    """Motion truth of a's truth points (H, W, 3) (float64, NaN = no surface) on objects (H, W) at
-    frame b. ``visible_fn_b(center_world, points (M, 3)) -> (M,) bool`` casts in b's scene."""
-    P = np.asarray(points_world_a, np.float64)
-    H, W, _ = P.shape
-    Pb, present = move_points(P.reshape(-1, 3), object_ids_a, poses_a, poses_b)
-    c = correspond(Pb.reshape(H, W, 3), camera_b, cam_b_from_world, visible_fn_b)
-    state = c.state.copy()
-    state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
-    return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)
-
-
 def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: FrameGeometry,
                  rows_a=None) -> MotionTruth:
     """Motion truth of a's truth points (H, W, 3) (float64, NaN = no surface) on objects (H, W) at
@@ -72,8 +56,11 @@ def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: 
     P = np.asarray(points_world_a, np.float64)
     H, W, _ = P.shape
     if frame_a.rolling is None and frame_b.rolling is None:
-        return moved_correspondence(P, object_ids_a, frame_a.poses, frame_b.poses, frame_b.camera,
-                                    frame_b.cam_from_world, frame_b.visible_fn)
+        Pb, present = move_points(P.reshape(-1, 3), object_ids_a, frame_a.poses, frame_b.poses)
+        c = frame_b.correspond(Pb.reshape(H, W, 3))
+        state = c.state.copy()
+        state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
+        return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)
     movers = moving_ids([frame_a, frame_b])
     if frame_a.rolling is None:
         rows_a = None

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenegen.crossview.correspondence import correspond
 from scenegen.crossview.frames import FrameGeometry, image, moving_ids, to_object
 from scenegen.crossview.motion import move_points
 from scenegen.dataset.crossview import OUT_OF_FRAME, VISIBLE
@@ -44,7 +43,7 @@ def track_points(groups, frames: list[FrameGeometry]):
             moved = [move_points(P, ids, q.poses, fr.poses) for P, ids, q, _ in groups]
             Pk = np.concatenate([m[0] for m in moved]) if moved else np.zeros((0, 3))
             present = np.concatenate([m[1] for m in moved]) if moved else np.zeros(0, bool)
-            c = correspond(Pk.reshape(n, 1, 3), fr.camera, fr.cam_from_world, fr.visible_fn)
+            c = fr.correspond(Pk.reshape(n, 1, 3))
         state = c.state.reshape(n)
         xy[:, k] = c.uv.reshape(n, 2)
         occ[:, k] = (state != VISIBLE) | ~present

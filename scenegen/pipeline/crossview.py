@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.crossview.correspondence import correspond, flow_field
+from scenegen.crossview.correspondence import flow_field
 from scenegen.crossview.frames import FrameGeometry
 from scenegen.crossview.motion import frame_motion
 from scenegen.crossview.matches import MatchParams, label_real_matches, sift_matches, synthetic_matches
@@ -48,7 +48,7 @@ from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
 from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.stereo import write_stereo_frame
-from scenegen.pipeline.view import rolling_rows, view_truth, visibility_fn
+from scenegen.pipeline.view import correspond_fn, rolling_rows, view_truth, visibility_fn
 
 #: Spec geometry kinds that are planes in their object's z = 0 plane (normal +z): they get a
 #: homography per pair.
@@ -96,7 +96,7 @@ class _Context:
             rows = rolling_rows(self.built, v)
             poses = {o.object_id: (self.object_pose(o, name), True) for o in self.spec.objects}
             self._geometry[name] = FrameGeometry(poses, self.built.cameras[v.camera], v.cam_from_world,
-                                                 visibility_fn(self.built, v, rows), rows)
+                                                 visibility_fn(self.built, v, rows), rows, correspond_fn(self.built, v))
         return self._geometry[name]
 
     def at(self, name) -> None:
@@ -112,12 +112,10 @@ class _Context:
 
     def corr(self, i, j) -> Correspondence:
         if (i, j) not in self._corr:
-            cam_j, pose_j = self.camera(j)
             points = self.points(i)
             gi, gj = self.geometry(i), self.geometry(j)
-            if gi.rolling is None and gj.rolling is None:
-                self.at(j)  # j's scene casts the visibility (the same time as i's: checked at validation)
-                self._corr[(i, j)] = correspond(points, cam_j, pose_j, self.built.visible_from)
+            if gi.rolling is None and gj.rolling is None:  # in j's scene (the same time as i's: validated)
+                self._corr[(i, j)] = gj.correspond(points)
             else:  # i's points at their rows' times, imaged by j's rows
                 self._corr[(i, j)] = frame_motion(points, self._ids[i], gi, gj).correspondence
         return self._corr[(i, j)]
@@ -171,12 +169,11 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
         ctx.at(a)
         ga, gb = ctx.geometry(a), ctx.geometry(b)
         if ga.rolling is None and gb.rolling is None:
-            P, _ = ctx.built.surface_points(cam_a, pose_a, pi)
-            ctx.at(b)
-            c = correspond(P.reshape(-1, 1, 3), cam_b, pose_b, ctx.built.visible_from)
+            P = ctx.built.surface_points(cam_a, pose_a, pi)
+            c = gb.correspond(P.reshape(-1, 1, 3))
         else:  # each keypoint's surface point at its row's time, imaged by b's rows
             rows = ga.rolling
-            P, ids = ctx.built.surface_points(cam_a, pose_a, pi, rows=None if rows is None else rows.cam,
+            P, ids = ctx.built.surface_hits(cam_a, pose_a, pi, rows=None if rows is None else rows.cam,
                                               moves=rows.object_moves(pi[:, 1]) if rows and rows.objects else None)
             ids = np.zeros(len(pi), np.uint32) if ids is None else ids
             c = frame_motion(P.reshape(-1, 1, 3), ids.reshape(-1, 1), ga, gb, rows_a=pi[:, 1]).correspondence

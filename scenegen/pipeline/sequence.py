@@ -29,7 +29,7 @@ from scenegen.dataset.sequence import (
 )
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.pipeline.pairs import streams
-from scenegen.pipeline.view import rolling_rows, rolling_shutter_rows, view_truth, visibility_fn
+from scenegen.pipeline.view import correspond_fn, rolling_rows, rolling_shutter_rows, view_truth, visibility_fn
 from scenegen.spec.timeline import Timeline
 
 
@@ -73,7 +73,8 @@ class SequenceTruth:
         if view.name not in self._geometry:
             rows = rolling_rows(self.built, view)
             self._geometry[view.name] = FrameGeometry(self.poses(view), self.built.cameras[view.camera],
-                                                      view.cam_from_world, visibility_fn(self.built, view, rows), rows)
+                                                      view.cam_from_world, visibility_fn(self.built, view, rows), rows,
+                                                      correspond_fn(self.built, view))
         return self._geometry[view.name]
 
     def motion(self, a, b):

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenegen.crossview.correspondence import correspond
 from scenegen.dataset.codecs import (
     encode_exr,
     encode_json,
@@ -25,6 +24,7 @@ from scenegen.geometry.color import srgb_image
 from scenegen.geometry.rectify import disparity_from_depth, rectification_map, rectify
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView
+from scenegen.pipeline.view import correspond_points
 
 
 def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> dict:
@@ -48,7 +48,7 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
     for side, other_pose in zip(STEREO_SIDES, (rect.cam_right_from_world, rect.cam_left_from_world)):
         pts, depth = truths[side]
         d = disparity_from_depth(depth, rect.f, rect.baseline_m)
-        c = correspond(pts, rc, other_pose, built.visible_from)
+        c = correspond_points(built, pts, rc, other_pose)
         ctx.write(stereo_path(left, "disparity_pfm", side), encode_pfm(d))
         ctx.write(stereo_path(left, "disparity_occ", side), encode_kitti_disparity(d, np.isfinite(d)))
         ctx.write(stereo_path(left, "disparity_noc", side), encode_kitti_disparity(d, c.state == VISIBLE))

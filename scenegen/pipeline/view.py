@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from scenegen.crossview.correspondence import correspond
 from scenegen.geometry.color import srgb_image
 from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict, row_poses
 from scenegen.geometry.rolling import RollingRows, RowPoses
@@ -57,6 +58,23 @@ def visibility_fn(built, view, rows: RollingRows | None):
         moves = rows.object_moves(point_rows) if rows is not None and rows.objects else None
         return built.visible_from(centres, points, moves=moves)
     return visible
+
+
+def correspond_points(built, points_world, camera, cam_from_world):
+    """Correspondences of world points (H, W, 3) in a view of the loaded scene as it is: in one
+    kernel where it applies (:meth:`scenegen.render.scene.LoadedScene.correspond`), else
+    :func:`scenegen.crossview.correspondence.correspond` with the visibility cast."""
+    if built.kernel_correspondences:
+        return built.correspond(points_world, camera, cam_from_world)
+    return correspond(points_world, camera, cam_from_world, built.visible_from)
+
+
+def correspond_fn(built, view):
+    """A frame's correspondences of world points at the view's time (global shutter)."""
+    def corr(points, camera, cam_from_world):
+        built.set_time(getattr(view, "time_s", None))
+        return correspond_points(built, points, camera, cam_from_world)
+    return corr
 
 
 def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:

@@ -14,6 +14,7 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast, sensor as sensor_mod
+from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
 from scenegen.render.lights import light_entry, light_key, loaded_emitters
@@ -115,10 +116,26 @@ class LoadedScene:
         return raycast.visible_from(self.scene, center_world, points_world, alpha_masked=self.alpha_masked,
                                     timed=timed)
 
-    def surface_points(self, camera, cam_from_world: Rigid3, uv, rows=None, moves=None):
-        """((N, 3) world points seen through sub-pixel positions, (N,) their object ids or None)
-        (:func:`scenegen.render.raycast.surface_points`; ``rows``: a rolling shutter's
-        world_from_cam per row, ``moves``: the moving objects at the positions' rows)."""
+    @property
+    def kernel_correspondences(self) -> bool:
+        """:meth:`correspond` applies: a vectorised variant and no alpha masks (their holes need
+        the visibility cast of :meth:`visible_from`)."""
+        return not self.alpha_masked and not mi.variant().startswith("scalar")
+
+    def correspond(self, points_world, camera, cam_from_world: Rigid3):
+        """Correspondences of truth points (H, W, 3) (float64, NaN = no surface) in a view, in
+        one kernel (:mod:`scenegen.render.correspond`: the definition of
+        :func:`scenegen.crossview.correspondence.correspond`); needs :attr:`kernel_correspondences`."""
+        return correspond_in_kernel(self.scene, points_world, camera, cam_from_world)
+
+    def surface_points(self, camera, cam_from_world: Rigid3, uv) -> np.ndarray:
+        """(N, 3) world points seen through sub-pixel positions (:func:`scenegen.render.raycast.surface_points`)."""
+        return raycast.surface_points(self.scene, camera, cam_from_world, uv, self.alpha_masked)[0]
+
+    def surface_hits(self, camera, cam_from_world: Rigid3, uv, rows=None, moves=None):
+        """((N, 3) world points seen through sub-pixel positions, (N,) their object ids or None):
+        :meth:`surface_points` through a rolling shutter (``rows``: the camera's world_from_cam
+        per row; ``moves``: the moving objects at the positions' rows, then the ids come back)."""
         timed = None if moves is None else (self.timed(), moves)
         return raycast.surface_points(self.scene, camera, cam_from_world, uv, self.alpha_masked, rows, timed)
 
