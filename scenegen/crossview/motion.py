@@ -7,6 +7,11 @@ then b's single camera model projects P_b (:func:`scenegen.crossview.corresponde
 and the ray cast of b's scene decides its state: VISIBLE, OCCLUDED, OUT_OF_FRAME, as for the
 static correspondences. A point whose object does not exist at b (outside its ``visible_s``) is
 OCCLUDED wherever it projects into b's image. Scene flow is ``P_b - P_a`` in the world frame.
+
+For a stereo rig (:func:`moved_stereo_correspondence`) the same moved points are projected into
+b's RECTIFIED pair (the ideal pinholes of :func:`scenegen.geometry.rectify.rectify` at b): the
+left view gives flow and depth z_b, the disparity is ``f_b B_b / z_b`` and the right view's ray
+cast decides the second state (KITTI 2015 scene flow's flow and disp_1).
 """
 from __future__ import annotations
 
@@ -16,8 +21,9 @@ import numpy as np
 
 from scenegen.crossview.correspondence import correspond
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE, Correspondence
-from scenegen.dataset.sequence import MotionTruth
+from scenegen.dataset.sequence import MotionTruth, StereoMotionTruth
 from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.rectify import Rectification, disparity_from_depth
 
 Poses = Mapping[int, tuple[Rigid3, bool]]  # object id -> (world_from_object, present)
 
@@ -49,6 +55,15 @@ def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tup
     return out, present
 
 
+def _state_at_b(points_b, present, camera_b, cam_b_from_world: Rigid3, visible_fn_b) -> Correspondence:
+    """Correspondence of moved points (H, W, 3) in one camera of b; a point whose object does not
+    exist at b is OCCLUDED wherever it would be seen."""
+    c = correspond(points_b, camera_b, cam_b_from_world, visible_fn_b)
+    state = c.state.copy()
+    state[(state == VISIBLE) & ~present] = OCCLUDED
+    return Correspondence(c.uv, c.z, state)
+
+
 def moved_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: Poses, camera_b,
                          cam_b_from_world: Rigid3,
                          visible_fn_b: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> MotionTruth:
@@ -57,7 +72,22 @@ def moved_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: 
     P = np.asarray(points_world_a, np.float64)
     H, W, _ = P.shape
     Pb, present = move_points(P.reshape(-1, 3), object_ids_a, poses_a, poses_b)
-    c = correspond(Pb.reshape(H, W, 3), camera_b, cam_b_from_world, visible_fn_b)
-    state = c.state.copy()
-    state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
-    return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)
+    Pb, present = Pb.reshape(H, W, 3), present.reshape(H, W)
+    return MotionTruth(_state_at_b(Pb, present, camera_b, cam_b_from_world, visible_fn_b), Pb - P)
+
+
+def moved_stereo_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: Poses,
+                                rect_b: Rectification,
+                                visible_fn_b: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> StereoMotionTruth:
+    """Stereo motion truth of a's rectified left truth points (H, W, 3) (float64, NaN = no
+    surface) on objects (H, W) in b's rectified pair ``rect_b``: flow and depth in its left view,
+    disparity ``f_b B_b / z_b``, the states in both views. ``visible_fn_b`` casts in b's scene
+    (from the rectified centres, which are the raw cameras' centres)."""
+    P = np.asarray(points_world_a, np.float64)
+    H, W, _ = P.shape
+    Pb, present = move_points(P.reshape(-1, 3), object_ids_a, poses_a, poses_b)
+    Pb, present = Pb.reshape(H, W, 3), present.reshape(H, W)
+    left = _state_at_b(Pb, present, rect_b.camera, rect_b.cam_left_from_world, visible_fn_b)
+    right = _state_at_b(Pb, present, rect_b.camera, rect_b.cam_right_from_world, visible_fn_b)
+    return StereoMotionTruth(MotionTruth(left, Pb - P), right.state,
+                             disparity_from_depth(left.z, rect_b.f, rect_b.baseline_m))
