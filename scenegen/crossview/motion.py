@@ -9,16 +9,23 @@ static correspondences. A point whose object does not exist at b (outside its ``
 OCCLUDED wherever it projects into b's image. Scene flow is ``P_b - P_a`` in the world frame.
 Through a rolling shutter (:func:`frame_motion`), P_a is where the point was when a's row saw it
 and P_b where it is when the row of b that images it is exposed (:mod:`scenegen.crossview.frames`).
+
+For a stereo rig (:func:`moved_stereo_correspondence`) the same moved points are projected into
+b's RECTIFIED pair (the ideal pinholes of :func:`scenegen.geometry.rectify.rectify` at b): the
+left view gives flow and depth z_b, the disparity is ``f_b B_b / z_b`` and the right view's ray
+cast decides the second state (KITTI 2015 scene flow's flow and disp_1).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 
 import numpy as np
 
 from scenegen.crossview.frames import FrameGeometry, Poses, image, moving_ids, to_object
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE, Correspondence
-from scenegen.dataset.sequence import MotionTruth
+from scenegen.dataset.sequence import MotionTruth, StereoMotionTruth
 from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.rectify import Rectification, disparity_from_depth
 
 
 def _apply(T: Rigid3, P: np.ndarray) -> np.ndarray:
@@ -48,6 +55,13 @@ def move_points(points_world, object_ids, poses_a: Poses, poses_b: Poses) -> tup
     return out, present
 
 
+def _present_state(c: Correspondence, present) -> Correspondence:
+    """``c`` with a point whose object does not exist at b OCCLUDED wherever it would be seen."""
+    state = c.state.copy()
+    state[(state == VISIBLE) & ~present] = OCCLUDED
+    return Correspondence(c.uv, c.z, state)
+
+
 def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: FrameGeometry,
                  rows_a=None) -> MotionTruth:
     """Motion truth of a's truth points (H, W, 3) (float64, NaN = no surface) on objects (H, W) at
@@ -57,10 +71,8 @@ def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: 
     H, W, _ = P.shape
     if frame_a.rolling is None and frame_b.rolling is None:
         Pb, present = move_points(P.reshape(-1, 3), object_ids_a, frame_a.poses, frame_b.poses)
-        c = frame_b.correspond(Pb.reshape(H, W, 3))
-        state = c.state.copy()
-        state[(state == VISIBLE) & ~present.reshape(H, W)] = OCCLUDED
-        return MotionTruth(Correspondence(c.uv, c.z, state), Pb.reshape(H, W, 3) - P)
+        Pb = Pb.reshape(H, W, 3)
+        return MotionTruth(_present_state(frame_b.correspond(Pb), present.reshape(H, W)), Pb - P)
     movers = moving_ids([frame_a, frame_b])
     if frame_a.rolling is None:
         rows_a = None
@@ -71,3 +83,20 @@ def frame_motion(points_world_a, object_ids_a, frame_a: FrameGeometry, frame_b: 
     c = im.correspondence
     return MotionTruth(Correspondence(c.uv.reshape(H, W, 2), c.z.reshape(H, W), c.state.reshape(H, W)),
                       im.points_world.reshape(H, W, 3) - P)
+
+
+def moved_stereo_correspondence(points_world_a, object_ids_a, poses_a: Poses, poses_b: Poses,
+                                rect_b: Rectification, correspond_b: Callable) -> StereoMotionTruth:
+    """Stereo motion truth of a's rectified left truth points (H, W, 3) (float64, NaN = no
+    surface) on objects (H, W) in b's rectified pair ``rect_b``: flow and depth in its left view,
+    disparity ``f_b B_b / z_b``, the states in both views. ``correspond_b(points (H, W, 3),
+    camera, cam_from_world) -> Correspondence`` in b's scene (the rectified centres are the raw
+    cameras' centres)."""
+    P = np.asarray(points_world_a, np.float64)
+    H, W, _ = P.shape
+    Pb, present = move_points(P.reshape(-1, 3), object_ids_a, poses_a, poses_b)
+    Pb, present = Pb.reshape(H, W, 3), present.reshape(H, W)
+    left = _present_state(correspond_b(Pb, rect_b.camera, rect_b.cam_left_from_world), present)
+    right = _present_state(correspond_b(Pb, rect_b.camera, rect_b.cam_right_from_world), present)
+    return StereoMotionTruth(MotionTruth(left, Pb - P), right.state,
+                             disparity_from_depth(left.z, rect_b.f, rect_b.baseline_m))

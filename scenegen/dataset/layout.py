@@ -27,6 +27,8 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     sequence/objects.json                   every object's world_from_object, presence, velocities per frame
     sequence/motion/<a>/<b>.exr             flow, scene flow, depth in b, occlusion state of a's pixels at b
     sequence/flow/<a>/<b>.flo               optical flow a -> b (moving objects moved)
+    sequence/stereo_motion/<a>/<b>.exr      a stereo rig's rectified left a -> b: flow, depth and disparity
+                                            at b, states in b's rectified left and right views
     sequence/tracks/<stream>.npz            TAP-Vid-style point tracks of a camera stream
 
 Every name that becomes part of a path is checked here (:func:`check_name`): names read from a
@@ -225,6 +227,12 @@ def motion_path(a: str, b: str) -> str:
 def sequence_flow_path(a: str, b: str) -> str:
     """Optical flow a -> b of a sequence, Middlebury .flo."""
     return f"{SEQUENCE}/flow/{check_view_name(a)}/{check_view_name(b)}.flo"
+
+
+def stereo_motion_path(a: str, b: str) -> str:
+    """Flow, depth, disparity and states at b of the rectified left view of stereo frame a (EXR;
+    a, b: the frames' left views)."""
+    return f"{SEQUENCE}/stereo_motion/{check_view_name(a)}/{check_view_name(b)}.exr"
 
 
 def tracks_path(stream: str) -> str:

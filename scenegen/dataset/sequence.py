@@ -7,6 +7,13 @@ the per-frame object poses and the index of ``sequence/``.
   2 occluded, 3 out of frame), ``scene_flow.X/Y/Z`` (FLOAT): the point's 3D displacement
   P_b - P_a in the WORLD frame, metres. Optical flow = (u, v) - pixel of a; NaN where a saw
   nothing (or the point does not project into b's model).
+* ``sequence/stereo_motion/<a>/<b>.exr`` (a, b: LEFT views of a stereo rig's frames), over the
+  pixels of a's RECTIFIED left view (the ideal pinhole of ``crossview/stereo/<a>/``): ``u``, ``v``
+  (FLOAT, where the surface point lands in b's rectified left view), ``z`` (FLOAT, its depth along
+  b's rectified left axis, metres), ``disparity`` (FLOAT, ``f_b * B_b / z``, pixels of b's
+  rectified pair; +inf where the point has no positive depth), ``state`` (UINT, in b's rectified
+  left view) and ``state_right`` (UINT, in b's rectified right view), ``scene_flow.X/Y/Z`` (FLOAT,
+  P_b - P_a, world frame, metres). NaN u, v, z where a saw nothing or the point does not project.
 * ``sequence/objects.json``: per frame, every object's ``world_from_object`` (rigid, no scale),
   whether it exists (``present``) and its world-frame ``linear_velocity_mps`` (of its origin) and
   ``angular_velocity_rad_s``.
@@ -18,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.dataset.crossview import Correspondence
+from scenegen.dataset.crossview import VISIBLE, Correspondence
 
 SEQUENCE_FORMAT = "scenegen-sequence"
 SEQUENCE_FORMAT_VERSION = 1
@@ -64,6 +71,49 @@ def decode_motion_channels(channels: Mapping[str, np.ndarray]) -> MotionTruth:
     c = Correspondence(uv, np.asarray(channels["z"], np.float64), np.asarray(channels["state"]).astype(np.uint8))
     sf = np.stack([channels[k] for k in SCENE_FLOW_CHANNELS], -1).astype(np.float64)
     return MotionTruth(c, sf)
+
+
+@dataclass(frozen=True, eq=False)
+class StereoMotionTruth:
+    """Where the surface points of a's RECTIFIED left pixels are at b, in b's rectified pair
+    (arrays over a's rectified left pixels): KITTI 2015 scene flow's flow and second disparity."""
+
+    left: MotionTruth  # uv, z and state in b's rectified left view; world scene flow
+    state_right: np.ndarray  # (H, W) uint8 state in b's rectified right view
+    disparity: np.ndarray  # (H, W) float64 f_b B_b / z_b, pixels; +inf: no positive depth at b
+
+    @property
+    def flow(self) -> np.ndarray:
+        """(H, W, 2) float64 optical flow of the rectified left view a -> b, pixels; NaN unknown."""
+        return self.left.flow
+
+    @property
+    def state(self) -> np.ndarray:
+        """(H, W) uint8 state in b's rectified left view."""
+        return self.left.state
+
+    @property
+    def visible_both(self) -> np.ndarray:
+        """(H, W) bool: b's rectified left AND right views see the moved point."""
+        return (self.left.state == VISIBLE) & (self.state_right == VISIBLE)
+
+
+STEREO_MOTION_CHANNELS = ("disparity", "state_right")
+
+
+def encode_stereo_motion_channels(m: StereoMotionTruth) -> dict[str, np.ndarray]:
+    out = encode_motion_channels(m.left)
+    out.update({"disparity": m.disparity.astype(np.float32), "state_right": m.state_right.astype(np.uint32)})
+    return out
+
+
+def decode_stereo_motion_channels(channels: Mapping[str, np.ndarray]) -> StereoMotionTruth:
+    """Inverse of :func:`encode_stereo_motion_channels`; KeyError naming a missing channel."""
+    missing = [k for k in STEREO_MOTION_CHANNELS if k not in channels]
+    if missing:
+        raise KeyError(f"stereo motion channels {missing} missing; have {sorted(channels)}")
+    return StereoMotionTruth(decode_motion_channels(channels), np.asarray(channels["state_right"]).astype(np.uint8),
+                             np.asarray(channels["disparity"], np.float64))
 
 
 def objects_document(frames) -> dict:

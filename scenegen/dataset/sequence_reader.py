@@ -1,6 +1,7 @@
 """Typed access to a dataset's sequence truth (docs/crossview.md, "Sequences"): the index, every
-object's pose per frame, the motion truth of a frame pair (flow, scene flow, occlusion state)
-and the point tracks of a stream. Reached as ``Dataset(path).sequence``."""
+object's pose per frame, the motion truth of a frame pair (flow, scene flow, occlusion state),
+a stereo rig's motion truth on the rectified grid (KITTI scene flow) and the point tracks of a
+stream. Reached as ``Dataset(path).sequence``."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -9,8 +10,22 @@ import numpy as np
 
 from scenegen.dataset.codecs import TrackSet, decode_flo, read_exr, read_json, read_tracks
 from scenegen.dataset.errors import DatasetError
-from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
-from scenegen.dataset.sequence import SEQUENCE_FORMAT, SEQUENCE_FORMAT_VERSION, MotionTruth, decode_motion_channels
+from scenegen.dataset.layout import (
+    SEQUENCE_INDEX,
+    SEQUENCE_OBJECTS,
+    motion_path,
+    sequence_flow_path,
+    stereo_motion_path,
+    tracks_path,
+)
+from scenegen.dataset.sequence import (
+    SEQUENCE_FORMAT,
+    SEQUENCE_FORMAT_VERSION,
+    MotionTruth,
+    StereoMotionTruth,
+    decode_motion_channels,
+    decode_stereo_motion_channels,
+)
 from scenegen.geometry.pose import Rigid3
 
 
@@ -19,6 +34,7 @@ class SequenceIndex:
     timestamps_s: tuple[float, ...]
     pairs: tuple[tuple[str, str, int], ...]  # (a, b, step): motion truth a -> b and b -> a
     streams: dict  # stream name -> its frames (view names, in order)
+    stereo_pairs: tuple[tuple[str, str, int], ...] = ()  # (left a, left b, step): stereo motion both ways
 
     @classmethod
     def from_dict(cls, d) -> SequenceIndex:
@@ -27,7 +43,8 @@ class SequenceIndex:
                              f"{d.get('format')!r} version {d.get('format_version')!r}")
         return cls(tuple(float(t) for t in d["timestamps_s"]),
                    tuple((p["a"], p["b"], int(p["step"])) for p in d["pairs"]),
-                   {t["stream"]: tuple(t["frames"]) for t in d["tracks"]})
+                   {t["stream"]: tuple(t["frames"]) for t in d["tracks"]},
+                   tuple((p["a"], p["b"], int(p["step"])) for p in d.get("stereo_pairs", ())))
 
 
 class SequenceTruth:
@@ -64,6 +81,12 @@ class SequenceTruth:
     def flow(self, a: str, b: str) -> np.ndarray:
         """(H, W, 2) float32 optical flow a -> b (NaN unknown), from the .flo file."""
         return self._ds.read(sequence_flow_path(a, b), lambda p: decode_flo(p.read_bytes()), f"flow {a} -> {b}")
+
+    def stereo_motion(self, a: str, b: str) -> StereoMotionTruth:
+        """Where the rectified left surface points of stereo frame a (its left view) are in b's
+        rectified pair: flow, depth, disparity f B / z and the states in both views."""
+        return self._ds.read(stereo_motion_path(a, b), lambda p: decode_stereo_motion_channels(read_exr(p)),
+                             f"stereo motion truth {a} -> {b} (a stereo rig with crossview.stereo in a sequence)")
 
     def tracks(self, stream: str) -> TrackSet:
         """The point tracks of a camera stream (:mod:`scenegen.dataset.codecs.tracks`)."""

@@ -15,14 +15,29 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
   groundtruth.txt, associations.txt.
 * ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream;
 * ``tracks-video``: a GIF and an MP4 per stream of a sequence with its point tracks drawn;
-* ``kitti-flow``: KITTI 2015 flow layout (flow_occ / flow_noc PNGs) from a sequence's flow.
+* ``kitti-flow``: KITTI 2015 flow layout (flow_occ / flow_noc PNGs) from a sequence's flow;
+* ``kitti-sceneflow``: KITTI 2015 scene flow layout (disp_*_0, disp_*_1, flow_* on the rectified
+  left grid, obj_map, calib) from a stereo rig's sequence;
+* ``sintel``: MPI-Sintel layout (final/, flow/, occlusions/, invalid/, depth/, camdata_left/) per
+  camera stream of a sequence of pinhole cameras.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from scenegen.export import (
-    colmap, gaussian_splatting, kitti_flow, kitti_stereo, middlebury, nerf, opencv_yaml, tapvid, tracks_video, tum,
+    colmap,
+    gaussian_splatting,
+    kitti_flow,
+    kitti_sceneflow,
+    kitti_stereo,
+    middlebury,
+    nerf,
+    opencv_yaml,
+    sintel,
+    tapvid,
+    tracks_video,
+    tum,
 )
 from scenegen.export.common import open_dataset, staged_dest
 from scenegen.export.errors import ExportError
@@ -32,11 +47,12 @@ from scenegen.export.errors import ExportError
 FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
-           "kitti-flow": kitti_flow.export}
+           "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
-                  "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs"}
+                  "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
+                  "kitti-sceneflow": "stereo frame pairs", "sintel": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

@@ -1,7 +1,8 @@
 """The sequence stage of the pipeline: runs after every view of a sequence is rendered and writes
 its truth across time (docs/crossview.md, "Sequences") through the dataset writer: every
 object's pose per frame, flow / scene flow / occlusion for frame pairs (k, k + step) of each
-camera stream both ways, and point tracks.
+camera stream both ways, point tracks, and for a stereo rig with rectified frames the scene flow
+truth on the rectified left grid (:mod:`.stereo_sequence`).
 
 Truth points of frame a come from the truth pass at a's time in float64 (centre + range * ray,
 range from the float32 intersection); the scene is moved to b's time for b's visibility casts
@@ -19,16 +20,25 @@ from scenegen.crossview.motion import frame_motion
 from scenegen.crossview.tracks import track_points
 from scenegen.dataset.codecs import TrackSet, encode_exr, encode_flo, encode_json, encode_tracks
 from scenegen.dataset.crossview import STATE_NAMES
-from scenegen.dataset.layout import SEQUENCE_INDEX, SEQUENCE_OBJECTS, motion_path, sequence_flow_path, tracks_path
+from scenegen.dataset.layout import (
+    SEQUENCE_INDEX,
+    SEQUENCE_OBJECTS,
+    motion_path,
+    sequence_flow_path,
+    stereo_motion_path,
+    tracks_path,
+)
 from scenegen.dataset.sequence import (
     SCENE_FLOW_FRAME,
     SEQUENCE_FORMAT,
     SEQUENCE_FORMAT_VERSION,
     encode_motion_channels,
+    encode_stereo_motion_channels,
     objects_document,
 )
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.pipeline.pairs import streams
+from scenegen.pipeline.stereo_sequence import StereoSequence, stereo_pairs
 from scenegen.pipeline.view import correspond_fn, rolling_rows, rolling_shutter_rows, view_truth, visibility_fn
 from scenegen.spec.timeline import Timeline
 
@@ -156,6 +166,15 @@ def run_sequence(spec, views, built, writer) -> dict | None:
         if seq.tracks is not None and all(v.name in names for v in vs):
             write(tracks_path(name), encode_tracks(stream_tracks(st, vs, name, seq.tracks)))
             index["tracks"].append({"stream": name, "frames": [v.name for v in vs]})
+    jobs = stereo_pairs(spec, views, names, seq.flow_steps)
+    if jobs:  # only then the key: sequences without rectified stereo keep their index bytes
+        ss = StereoSequence(st, keep_frames=2 * max(seq.flow_steps) + 2)
+        index["stereo_pairs"] = []
+        for step, fa, fb in jobs:
+            for i, j in ((fa, fb), (fb, fa)):
+                m = encode_stereo_motion_channels(ss.motion(i, j))
+                write(stereo_motion_path(i[0].name, j[0].name), encode_exr(m))
+            index["stereo_pairs"].append({"a": fa[0].name, "b": fb[0].name, "step": step})
     index["files"] = sorted(files)
     if len(done) == len(views):
         writer.write_file(SEQUENCE_INDEX, encode_json(index))

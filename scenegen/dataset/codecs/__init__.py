@@ -12,6 +12,7 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.pfm`: Middlebury/ETH3D float maps.
 * :mod:`.kitti`: KITTI uint16 disparity PNGs; :mod:`.kitti_flow`: KITTI 16-bit RGB flow PNGs.
 * :mod:`.flo`: Middlebury optical flow.
+* :mod:`.sintel`: MPI-Sintel depth (``.dpt``) and camera (``.cam``) files.
 * :mod:`.tracks`: TAP-Vid-style point tracks as a pickle-free NPZ.
 * :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
@@ -29,6 +30,7 @@ from scenegen.dataset.codecs.kitti_flow import decode_kitti_flow_png, encode_kit
 from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
+from scenegen.dataset.codecs.sintel import decode_cam, decode_dpt, encode_cam, encode_dpt
 from scenegen.dataset.codecs.tracks import (
     TRACK_KEYS, TrackSet, decode_tracks, encode_npz, encode_tracks, read_tracks, write_tracks,
 )
@@ -40,6 +42,6 @@ __all__ = [
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
     "decode_kitti_flow_png", "encode_kitti_flow_png",
     "decode_npy", "encode_npy", "read_npy", "write_npy", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
-    "decode_png", "encode_png", "read_png", "write_png",
+    "decode_png", "encode_png", "read_png", "write_png", "decode_cam", "decode_dpt", "encode_cam", "encode_dpt",
     "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_npz", "encode_tracks", "read_tracks", "write_tracks",
 ]

@@ -40,7 +40,7 @@ class CrossviewSpec:
     flow: bool = param(True, unit="flag")  # Middlebury .flo flow between consecutive frames of
     # each camera stream
     stereo: bool = param(True, unit="flag")  # rectified renders, disparity and maps for every
-    # stereo-rig frame
+    # stereo-rig frame (in a sequence also the scene flow truth on the rectified grid)
     matches: MatchSetSpec | None = part(None, unit="synthetic labelled match sets per pair "
                                                    "(None = off)")
     sift: bool = param(False, unit="flag")  # OpenCV SIFT matches per pair, labelled against the

@@ -261,3 +261,52 @@ class TestKitti:
     def test_refuses_non_uint16(self):
         with pytest.raises(ValueError, match="uint16"):
             sio.disparity_from_kitti_array(np.zeros((2, 2), np.uint8))
+
+
+class TestSintel:
+    """The Sintel SDK's sintel_io.py layout: float32 tag 202021.25, then (.dpt) int32 W, H and
+    float32 rows, (.cam) M (3x3) and N (3x4) float64, little-endian."""
+
+    def test_dpt_round_trip_and_layout(self):
+        d = _awkward_float32((3, 5))
+        data = sio.encode_dpt(d)
+        assert data[:4] == b"PIEH" and np.frombuffer(data, "<i4", 2, 4).tolist() == [5, 3] and len(data) == 12 + 60
+        assert np.array_equal(sio.decode_dpt(data).view(np.uint32), d.view(np.uint32))
+
+    def test_cam_round_trip_and_layout(self):
+        M, N = np.arange(9.0).reshape(3, 3) / 7, np.arange(12.0).reshape(3, 4) / 3
+        data = sio.encode_cam(M, N)
+        assert data[:4] == b"PIEH" and len(data) == 4 + 8 * 21
+        assert np.array_equal(np.frombuffer(data, "<f8", 9, 4).reshape(3, 3), M)
+        got = sio.decode_cam(data)
+        assert np.array_equal(got[0], M) and np.array_equal(got[1], N)
+
+    @pytest.mark.parametrize("data, msg", [(b"PIEX" + bytes(168), "not a Sintel"), (b"PIEH" + bytes(10), "bytes")])
+    def test_errors(self, data, msg):
+        with pytest.raises(ValueError, match=msg):
+            sio.decode_cam(data)
+        with pytest.raises(ValueError, match=msg if msg != "bytes" else "dpt"):
+            sio.decode_dpt(data)
+
+
+def test_stereo_motion_channels_round_trip():
+    from scenegen.dataset.crossview import Correspondence
+    from scenegen.dataset.sequence import (
+        MotionTruth,
+        StereoMotionTruth,
+        decode_stereo_motion_channels,
+        encode_stereo_motion_channels,
+    )
+
+    rng = np.random.default_rng(1)
+    f32 = lambda *s: rng.standard_normal(s).astype(np.float32).astype(np.float64)  # noqa: E731
+    c = Correspondence(f32(4, 5, 2), f32(4, 5), rng.integers(0, 4, (4, 5)).astype(np.uint8))
+    m = StereoMotionTruth(MotionTruth(c, f32(4, 5, 3)), rng.integers(0, 4, (4, 5)).astype(np.uint8), f32(4, 5))
+    back = decode_stereo_motion_channels(sio.decode_exr(sio.encode_exr(encode_stereo_motion_channels(m))))
+    for got, want in ((back.left.correspondence.uv, c.uv), (back.left.correspondence.z, c.z),
+                      (back.state, c.state), (back.state_right, m.state_right), (back.disparity, m.disparity),
+                      (back.left.scene_flow, m.left.scene_flow)):
+        assert np.array_equal(got, want)
+    assert np.array_equal(back.visible_both, (c.state == 1) & (m.state_right == 1))
+    with pytest.raises(KeyError, match="state_right"):
+        decode_stereo_motion_channels({k: v for k, v in encode_stereo_motion_channels(m).items() if k != "state_right"})
