@@ -136,6 +136,10 @@ class StereoFrame:
         """(H, W) uint32 instance id of the surface each rectified pixel centre sees (0 = none)."""
         return self._read("ids", side, read_exr, "ids")["instance_id"]
 
+    def object_ids(self, side: str) -> np.ndarray:
+        """(H, W) uint32 object id of the surface each rectified pixel centre sees (0 = none)."""
+        return self._read("ids", side, read_exr, "ids")["object_id"]
+
 
 class CrossviewTruth:
     """The cross-view truth of one dataset (see the module docstring)."""

@@ -73,6 +73,13 @@ class SequenceTruth:
         return {k: (Rigid3.from_dict(v["world_from_object"]), bool(v["present"]))
                 for k, v in frames[frame]["objects"].items()}
 
+    def moving_object_ids(self) -> set[int]:
+        """Object ids whose pose or presence changes over the sequence's frames."""
+        doc = self._ds.read(SEQUENCE_OBJECTS, read_json, "per-frame object poses")
+        first = doc["frames"][0]["objects"]
+        return {int(first[name]["object_id"]) for fr in doc["frames"][1:] for name, v in fr["objects"].items()
+                if v["present"] != first[name]["present"] or v["world_from_object"] != first[name]["world_from_object"]}
+
     def motion(self, a: str, b: str) -> MotionTruth:
         """Where a's surface points are at b: correspondence (uv, z, state) and world scene flow."""
         return self._ds.read(motion_path(a, b), lambda p: decode_motion_channels(read_exr(p)),

@@ -16,8 +16,11 @@ devkit's "reference frame", its readme.txt, "Dataset description"):
 * ``training/flow_occ/{k:06d}_10.png``: flow of the rectified left view a -> b on every pixel
   whose moved point projects into b's rectified left view (occluded and out of frame included);
   ``flow_noc``: only where b's rectified left view sees it;
-* ``training/obj_map/{k:06d}_10.png`` and ``training/calib_cam_to_cam/{k:06d}.txt`` of frame a,
-  as ``kitti-stereo`` writes them; ``pairs.json`` maps each index to our views.
+* ``training/obj_map/{k:06d}_10.png``: KITTI's foreground map of frame a's rectified left view,
+  uint8: the instance id where the pixel sees an object that moves over the sequence (its pose
+  or presence changes between frames: KITTI's moving cars), 0 on everything static;
+  ``training/calib_cam_to_cam/{k:06d}.txt`` of frame a as ``kitti-stereo`` writes it;
+  ``pairs.json`` maps each index to our views.
 
 Disparity PNGs: uint16 ``round(d * 256)``, 0 invalid (also d >= 256); flow PNGs: 16-bit RGB
 ``u = (R - 2^15) / 64``, valid where B = 1, clipped to the encodable [-512, 512) px
@@ -52,6 +55,7 @@ def export(ds, dest, progress=None) -> dict:
                           " and a stereo rig with crossview.stereo: true)")
     crossview_index(ds)
     out, n_obj, clipped = [], 0, 0
+    moving = np.array(sorted(ds.sequence.moving_object_ids()), np.uint32)
     for k, (a, b) in enumerate(pairs):
         tag = f"{k:06d}"
         fa, fb = ds.crossview.stereo(a), ds.crossview.stereo(b)
@@ -72,7 +76,8 @@ def export(ds, dest, progress=None) -> dict:
         with np.errstate(invalid="ignore"):
             clipped += int(np.count_nonzero(np.any(np.abs(flow) >= FLOW_LIMIT_PX, axis=2)))
         om = obj_map(ds, fa)
-        if om is not None:
+        if om is not None:  # foreground: what moves (KITTI's dynamic objects), the rest background
+            om = np.where(np.isin(fa.object_ids("left"), moving), om, 0).astype(np.uint8)
             write(dest, f"training/obj_map/{tag}_10.png", encode_png(om))
             n_obj += 1
         write(dest, f"training/calib_cam_to_cam/{tag}.txt", calib_cam_to_cam(fa.calib).encode())
