@@ -30,7 +30,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.rotation import matrix_from_rotvec, rotvec_from_matrix
@@ -72,6 +71,14 @@ class MotionState:
         acc = (self.linear_acceleration_mps2 + np.cross(ap, r) + np.cross(wp, r_dot)
                + lc + np.cross(wp, vc))
         return MotionState(self.world_from_frame @ child.world_from_frame, v, w, acc, alpha)
+
+
+def _cubic_spline():
+    # scipy.interpolate on use: 0.37 s to import, and every spec (the spec model imports this
+    # module) would pay it, also without a spline (docs/performance.md, "Start-up")
+    from scipy.interpolate import CubicSpline
+
+    return CubicSpline
 
 
 def _hat(v: np.ndarray) -> np.ndarray:
@@ -142,6 +149,7 @@ class KeyframeTrajectory:
         self._R = np.stack([p.R for p in self.poses])
         self._t = np.stack([p.t for p in self.poses])
         if len(self.poses) >= 2 and interpolation == "spline":
+            CubicSpline = _cubic_spline()
             self._pos = CubicSpline(self.times_s, self._t, bc_type="natural", axis=0)
             self._rot = CubicSpline(self.times_s, _unwrapped_rotvecs(self._R), bc_type="natural", axis=0)
 
@@ -192,7 +200,7 @@ class JointTrajectory:
         if np.any(np.diff(self.times_s) <= 0) or len(self.times_s) != len(self.values) or not len(self.values):
             raise ValueError("joint keyframes need strictly increasing times, one value each")
         self.interpolation, self.rest = interpolation, rest
-        self._q = (CubicSpline(self.times_s, self.values, bc_type="natural")
+        self._q = (_cubic_spline()(self.times_s, self.values, bc_type="natural")
                    if len(self.values) >= 2 and interpolation == "spline" else None)
 
     def _q_derivatives(self, t: float) -> tuple[float, float, float]:
