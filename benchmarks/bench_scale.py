@@ -186,6 +186,7 @@ def bench_journal(folder: Path, views: int, big: int = 100_000) -> None:
 
     # `big` tiny views: a killed run's journal (written here without fsyncs: same bytes), then resume
     w, names = writer("big", big)
+    w.abort()  # the run is killed here: the OS drops its lock on the folder (scenegen/dataset/lock.py)
     root = folder / "big"
     sha = ds.load_current_manifest(root)["manifest_sha256"]
     lines = [journal.encode_line(0, journal.header(sha))]

@@ -27,9 +27,12 @@ from scenegen.render.raycast import VISIBILITY_COHERENT
 
 
 def upload_points(points_world) -> tuple:
-    """The (H, W, 3) float64 points as three mi.Float64 columns (aligned copies), reusable for
-    every view they are projected into."""
-    P = np.asarray(points_world, np.float64)
+    """The (H, W, 3) points as three mi.Float64 columns: float32 points (the truth as stored) go
+    up as float32 and are widened in the kernel (exactly; a quarter of the bytes to copy), others
+    as float64."""
+    P = np.asarray(points_world)
+    if P.dtype == np.float32:
+        return tuple(mi.Float64(to_jit(mi.Float, P[..., i], np.float32)) for i in range(3))
     return tuple(to_jit(mi.Float64, P[..., i], np.float64) for i in range(3))
 
 

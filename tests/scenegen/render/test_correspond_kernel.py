@@ -34,14 +34,15 @@ views:
 """
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])  # the stored truth's points, or widened
 @pytest.mark.parametrize("i,j", [(0, 1), (1, 0), (0, 2), (2, 0), (1, 2), (2, 1)])
-def test_kernel_equals_the_numpy_reference(i, j):
+def test_kernel_equals_the_numpy_reference(i, j, dtype):
     spec = parse_spec(SPEC)
     views = resolve_views(spec)
     built = load_scene(spec, variant="llvm_ad_rgb", spp=1)
     vi, vj = views[i], views[j]
     t = built.truth(built.cameras[vi.camera], vi.cam_from_world, as_stored=True)
-    P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(np.float64)
+    P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(dtype)
     cam_j = built.cameras[vj.camera]
     ref = correspond(P, cam_j, vj.cam_from_world, built.visible_from)
     ours = built.correspond(P, cam_j, vj.cam_from_world)
