@@ -23,30 +23,42 @@ def view_seed(seed: int, view_index: int) -> int:
 
 
 def rolling_shutter_rows(built, view):
-    """Per-row ``cam_from_world`` for a moving camera with a rolling shutter, else None."""
-    shutter = getattr(built.optics.get(view.camera), "shutter", None)
-    if shutter is None or shutter.rolling_readout_s == 0 or view.motion is None or view.motion.is_static:
-        return None
-    return row_poses(view.cam_from_world, view.motion, shutter, built.cameras[view.camera].height)
+    """Per-row ``cam_from_world`` for a moving camera with a rolling shutter, else None (made
+    once per view)."""
+    return _rows(built, view)[0]
 
 
 def rolling_rows(built, view) -> RollingRows | None:
     """The camera's and the moving objects' poses at every row node of a rolling-shutter view in
-    which something moves within the frame (:mod:`scenegen.geometry.rolling`), else None."""
-    shutter = getattr(built.optics.get(view.camera), "shutter", None)
-    camera_moves = view.motion is not None and not view.motion.is_static
-    if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
-        return None
-    H = built.cameras[view.camera].height
-    nodes = np.arange(-1, H + 1, dtype=np.float64)
-    taus = shutter.row_time_s(nodes, H)
-    cam = RowPoses.over_rows(
-        lambda v: cam_from_world_at(view.cam_from_world, view.motion, float(taus[int(v) + 1])).inverse(), H)
-    objects, present = {}, {}
-    if built.movers:
-        for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
-            objects[oid], present[oid] = RowPoses(R, t, -1.0), p
-    return RollingRows(cam, objects, present)
+    which something moves within the frame (:mod:`scenegen.geometry.rolling`), else None (made
+    once per view)."""
+    return _rows(built, view)[1]
+
+
+def _rows(built, view):
+    """(per-row cam_from_world or None, RollingRows or None) of a view, cached on the scene: the
+    truth pass's row poses are the table's nodes 0 .. H-1 themselves."""
+    key = (view.name, getattr(view, "time_s", None))
+    if key not in built.view_rows:
+        shutter = getattr(built.optics.get(view.camera), "shutter", None)
+        camera_moves = view.motion is not None and not view.motion.is_static
+        if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
+            built.view_rows[key] = (None, None)
+        else:
+            H = built.cameras[view.camera].height
+            taus = shutter.row_time_s(np.arange(-1, H + 1, dtype=np.float64), H)
+            poses = row_poses(view.cam_from_world, view.motion, shutter, H) if camera_moves else None
+            edges = [cam_from_world_at(view.cam_from_world, view.motion, float(taus[k])) for k in (0, -1)]
+            cam = [edges[0], *(poses or [view.cam_from_world] * H), edges[1]]
+            world_from_cam = [p.inverse() for p in cam]
+            objects, present = {}, {}
+            if built.movers:
+                for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
+                    objects[oid], present[oid] = RowPoses(R, t, -1.0), p
+            rows = RollingRows(RowPoses(np.stack([p.R for p in world_from_cam]), np.stack([p.t for p in world_from_cam]),
+                                        -1.0), objects, present)
+            built.view_rows[key] = (poses, rows)
+    return built.view_rows[key]
 
 
 def visibility_fn(built, view, rows: RollingRows | None):

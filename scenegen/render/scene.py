@@ -55,6 +55,8 @@ class LoadedScene:
     entry_ids: tuple = ({}, {})  # (dict key -> object id, dict key -> instance id)
     movers: dict = field(default_factory=dict)  # object id -> spec object that moves within a frame
     timed_scenes: object = None  # render.timed.TimedScenes, made on first use (:meth:`timed`)
+    view_rows: dict = field(default_factory=dict)  # view name -> what the pipeline derived of its
+    # rows (rolling-shutter poses, scenegen.pipeline.view): made once per view, not per truth call
 
     @property
     def variant(self) -> str:
