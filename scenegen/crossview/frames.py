@@ -76,8 +76,7 @@ def _poses_at(frame: FrameGeometry, oid: int, rows):
     """((M, 3, 3), (M, 3), (M,) present) world_from_object of ``oid`` at ``rows`` of ``frame``
     (None: the frame's time)."""
     if rows is not None and frame.rolling is not None and oid in frame.rolling.objects:
-        R, t, present = frame.rolling.object_moves(rows)[oid] if len(rows) else (np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(0, bool))
-        return R, t, present
+        return frame.rolling.object_pose(oid, rows)
     pose, present = frame.poses[oid]
     n = 1 if rows is None else len(rows)
     return (np.broadcast_to(pose.R, (n, 3, 3)), np.broadcast_to(pose.t, (n, 3)), np.full(n, bool(present)))

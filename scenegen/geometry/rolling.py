@@ -163,6 +163,11 @@ class RollingRows:
         if rows is None:
             k = self.pixel_rows()
             return {oid: (rp.R[k], rp.t[k], self.present[oid][k]) for oid, rp in self.objects.items()}
+        return {oid: self.object_pose(oid, rows) for oid in self.objects}
+
+    def object_pose(self, object_id: int, rows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """((N, 3, 3) R, (N, 3) t world_from_object, (N,) present) of one moving object at
+        ``rows`` (N,): interpolated; present at the nearest node."""
         rows = np.asarray(rows, np.float64)
         near = np.clip(np.rint(rows - self.cam.first_row), 0, len(self.cam.R) - 1).astype(np.int64)
-        return {oid: (*rp.at(rows), self.present[oid][near]) for oid, rp in self.objects.items()}
+        return (*self.objects[object_id].at(rows), self.present[object_id][near])

@@ -44,9 +44,13 @@ crossview: {pairs: none}
 
 # Loaded by the doomed worker (dask worker --preload): at its first atomic rename of a dataset
 # temporary file (the file is complete and fsync'ed, not yet renamed) the process SIGKILLs itself.
+# Dask may execute a preload twice (from the given path and from its scratch-space copy): the
+# original os.replace is kept on the os module, so a second load does not wrap the first wrapper
+# (which recursed without end on every other rename, e.g. the asset cache's when it was cold).
 DIE_MID_WRITE = f'''
 import os, signal
-_replace = os.replace
+_replace = getattr(os, "_scenegen_test_original_replace", os.replace)
+os._scenegen_test_original_replace = _replace
 def _replace_then_die(src, dst, *args, **kwargs):
     if str(src).endswith("{TEMP_SUFFIX}"):
         with open(os.environ["SCENEGEN_TEST_KILLED_AT"], "w") as f:
