@@ -10,14 +10,19 @@ project solves it by fixed-point iteration on tabulated poses). Per-pixel truth,
 flow, occlusion states and tracks of the dataset must agree, and a global-shutter reading of the
 same frames must not (the test can fail).
 """
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation, Slerp
 
 from scenegen.dataset import Dataset
 from scenegen.dataset.codecs import decode_flo, read_exr, read_json, read_tracks
 from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIBLE
 from scenegen.pipeline.run import render_spec
+
+sys.path.insert(0, str(Path(__file__).parent))
+from analytic_scene import AnalyticScene, euler_deg, look, slerp_lerp  # noqa: E402
 
 pytestmark = [pytest.mark.render, pytest.mark.filterwarnings("ignore:invalid value:RuntimeWarning"),
               pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning")]
@@ -67,43 +72,23 @@ views:
         - {time_s: -0.1, eye: [0.4, -1.85, 1.25], target: [0, -0.025, 0.1]}
         - {time_s: 0.3, eye: [-0.4, -1.65, 1.45], target: [0, 0.075, 0.1]}
 """
-KEYS = {  # name: (t0, t1, p0, p1, euler0_deg, euler1_deg): the spec's keyframes, restated
-    "ball": (-0.1, 0.3, [-0.6, 0.2, 0.25], [0.6, -0.2, 0.45], [0, 0, 0], [0, 0, 80]),
-    "crate": (-0.1, 0.3, [0.6, 0.3, 0.125], [-0.5, 0.25, 0.275], [0, 0, -10], [40, 0, 150]),
-}
-CAM = (-0.1, 0.3, [0.4, -1.85, 1.25], [-0.4, -1.65, 1.45], [0, -0.025, 0.1], [0, 0.075, 0.1])
-IDS = {"floor": 1, "ball": 2, "crate": 3}
-HALF = np.array([0.15, 0.1, 0.125])
-
-
-def _look(eye, target):
-    z = np.subtract(target, eye) / np.linalg.norm(np.subtract(target, eye))
-    x = np.cross(z, [0, 0, 1.0])
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], 1)  # world_from_cam rotation, OpenCV axes
-
-
-def _slerp_lerp(t, t0, t1, Ra, Rb, pa, pb):
-    """(N, 3, 3), (N, 3) at times t (N,): slerp and lerp between two keyframes."""
-    u = np.clip((np.asarray(t, float) - t0) / (t1 - t0), 0, 1)
-    R = Slerp([0, 1], Rotation.from_matrix(np.stack([Ra, Rb])))(u).as_matrix()
-    return R, (1 - u)[:, None] * np.asarray(pa, float) + u[:, None] * np.asarray(pb, float)
+SCENE = AnalyticScene(  # the spec's objects, restated (tests/scenegen/pipeline/analytic_scene.py)
+    paths={"ball": (-0.1, 0.3, np.eye(3), euler_deg(0, 0, 80), [-0.6, 0.2, 0.25], [0.6, -0.2, 0.45]),
+           "crate": (-0.1, 0.3, euler_deg(0, 0, -10), euler_deg(40, 0, 150), [0.6, 0.3, 0.125], [-0.5, 0.25, 0.275])},
+    boxes={"crate": (0.15, 0.1, 0.125)}, ids={"floor": 1, "ball": 2, "crate": 3})
+IDS = SCENE.ids
+CAM_PATH = (-0.1, 0.3, look([0.4, -1.85, 1.25], [0, -0.025, 0.1]), look([-0.4, -1.65, 1.45], [0, 0.075, 0.1]),
+            [0.4, -1.85, 1.25], [-0.4, -1.65, 1.45])
 
 
 def world_from(name, t):
     """The test's own interpolation of an object (N times)."""
-    t = np.atleast_1d(np.asarray(t, float))
-    if name == "floor":
-        return np.broadcast_to(np.eye(3), (len(t), 3, 3)), np.zeros((len(t), 3))
-    t0, t1, p0, p1, e0, e1 = KEYS[name]
-    eul = lambda e: Rotation.from_euler("xyz", e, degrees=True).as_matrix()  # noqa: E731
-    return _slerp_lerp(t, t0, t1, eul(e0), eul(e1), p0, p1)
+    return SCENE.poses(name, t)
 
 
 def camera(t):
     """(N, 3, 3) world_from_cam rotations and (N, 3) centres at times t (N,)."""
-    t0, t1, e0, e1, g0, g1 = CAM
-    return _slerp_lerp(np.atleast_1d(t), t0, t1, _look(e0, g0), _look(e1, g1), e0, e1)
+    return slerp_lerp(t, *CAM_PATH)
 
 
 def row_time(t_frame, v):
@@ -112,29 +97,7 @@ def row_time(t_frame, v):
 
 def first_hits(o, d, t):
     """(N,) distance and object id of rays o + s d (N, 3) with every object at the ray's time t (N,)."""
-    n = len(d)
-    best, oid = np.full(n, np.inf), np.zeros(n, np.int64)
-    o = np.broadcast_to(o, d.shape)
-
-    def take(s, name):
-        better = (s > 1e-9) & (s < best)
-        best[better], oid[better] = s[better], IDS[name]
-
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = -o[:, 2] / d[:, 2]
-        p = o + s[:, None] * d
-        take(np.where((np.abs(p[:, 0]) <= 2) & (np.abs(p[:, 1]) <= 2), s, np.inf), "floor")
-        _, c = world_from("ball", t)
-        oc = o - c
-        b = np.sum(oc * d, 1)
-        disc = b * b - (np.sum(oc * oc, 1) - 0.25 ** 2)
-        take(np.where(disc >= 0, -b - np.sqrt(np.maximum(disc, 0)), np.inf), "ball")
-        R, c = world_from("crate", t)
-        ol, dl = np.einsum("nji,nj->ni", R, o - c), np.einsum("nji,nj->ni", R, d)
-        t1, t2 = (-HALF - ol) / dl, (HALF - ol) / dl
-        near, far = np.minimum(t1, t2).max(1), np.maximum(t1, t2).min(1)
-        take(np.where((near <= far) & (near > 0), near, np.inf), "crate")
-    return best, oid
+    return SCENE.first_hits(o, d, t)
 
 
 def project(P, t):

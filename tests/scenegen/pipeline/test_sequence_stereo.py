@@ -9,17 +9,22 @@ from both rectified centres in frame b's scene. The KITTI PNGs are read back wit
 decoding rules written out here (readme.txt, "Data format"), the Sintel files with readers
 written from the Sintel SDK's sintel_io.py (depth_read, cam_read, flow_read)."""
 import json
+import sys
+from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from scenegen.cli import main
 from scenegen.dataset import Dataset
 from scenegen.dataset.codecs import read_exr, read_json
 from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIBLE
 from scenegen.pipeline.run import render_spec
+
+sys.path.insert(0, str(Path(__file__).parent))
+from analytic_scene import SEQUENCE_SCENE, look, slerp_lerp  # noqa: E402
 
 pytestmark = [pytest.mark.render, pytest.mark.filterwarnings("ignore:invalid value:RuntimeWarning")]
 
@@ -91,73 +96,27 @@ crossview: {{pairs: none, flow: false, stereo: true}}
 
 
 # --- the independent derivation --------------------------------------------------------------
-def _look(eye, target):
-    z = np.subtract(target, eye) / np.linalg.norm(np.subtract(target, eye))
-    x = np.cross(z, [0, 0, 1.0])
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], 1)  # world_from_cam rotation, OpenCV axes
-
-
-def _lin(t, t1, a, b, Ra, Rb):
-    u = min(max(t / t1, 0.0), 1.0)
-    R = Slerp([0, 1], Rotation.from_matrix(np.stack([Ra, Rb])))([u]).as_matrix()[0]
-    return R, (1 - u) * np.asarray(a, float) + u * np.asarray(b, float)
-
-
-def _eul(*deg):
-    return Rotation.from_euler("xyz", deg, degrees=True).as_matrix()
+SCENE = SEQUENCE_SCENE  # the spec's objects, restated (tests/scenegen/pipeline/analytic_scene.py)
+IDS = SCENE.ids
+RIG_PATH = (0.0, 0.2, look([0.1, -1.8, 1.3], [0, 0, 0.1]), look([-0.25, -1.7, 1.4], [0, 0.05, 0.1]),
+            [0.1, -1.8, 1.3], [-0.25, -1.7, 1.4])
 
 
 def world_from(name, t):
     """(R, centre) of an object or of the rig frame at time t, interpolated here."""
-    if name == "ball":
-        return _lin(t, 0.2, [-0.3, 0.1, 0.25], [0.3, -0.1, 0.35], np.eye(3), _eul(0, 0, 40))
-    if name == "crate":
-        return _lin(t, 0.2, [0.35, 0.3, 0.125], [-0.2, 0.25, 0.2], _eul(0, 0, 10), _eul(20, 0, 80))
-    if name == "dice":
-        return np.eye(3), np.array([-0.45, -0.35, 0.075])
     if name == "rig":
-        e0, e1, t0, t1 = [0.1, -1.8, 1.3], [-0.25, -1.7, 1.4], [0, 0, 0.1], [0, 0.05, 0.1]
-        return _lin(t, 0.2, e0, e1, _look(e0, t0), _look(e1, t1))
-    return np.eye(3), np.zeros(3)
-
-
-BOXES = {"crate": (0.15, 0.1, 0.125), "dice": (0.075, 0.075, 0.075)}
-IDS = {"floor": 1, "ball": 2, "crate": 3, "dice": 4}
+        R, c = slerp_lerp(t, *RIG_PATH)
+        return R[0], c[0]
+    return SCENE.pose(name, t)
 
 
 def dice_present(t):
-    return 0.15 <= t <= 1.0
+    return bool(SCENE.present("dice", t)[0])
 
 
 def first_hits(o, d, t):
     """(N,) distance along unit rays o + s d to the first hit and (N,) object id (float64)."""
-    n = len(d)
-    best, oid = np.full(n, np.inf), np.zeros(n, np.int64)
-    o = np.broadcast_to(o, d.shape)
-
-    def take(s, name):
-        better = (s > 1e-9) & (s < best)
-        best[better], oid[better] = s[better], IDS[name]
-
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = -o[:, 2] / d[:, 2]
-        p = o + s[:, None] * d
-        take(np.where((np.abs(p[:, 0]) <= 2) & (np.abs(p[:, 1]) <= 2), s, np.inf), "floor")
-        _, c = world_from("ball", t)
-        oc = o - c
-        b = np.sum(oc * d, 1)
-        disc = b * b - (np.sum(oc * oc, 1) - 0.25 ** 2)
-        take(np.where(disc >= 0, -b - np.sqrt(np.maximum(disc, 0)), np.inf), "ball")
-        for name, half in BOXES.items():
-            if name == "dice" and not dice_present(t):
-                continue
-            R, c = world_from(name, t)
-            ol, dl = (o - c) @ R, d @ R
-            t1, t2 = (-np.asarray(half) - ol) / dl, (np.asarray(half) - ol) / dl
-            near, far = np.minimum(t1, t2).max(1), np.maximum(t1, t2).min(1)
-            take(np.where((near <= far) & (near > 0), near, np.inf), name)
-    return best, oid
+    return SCENE.first_hits(o, d, t)
 
 
 def _ry(deg):
@@ -196,13 +155,7 @@ def project(P, K_rect, R, C):
 
 
 def moved(P, ids, ta, tb):
-    out = P.copy()
-    for name, k in IDS.items():
-        sel = ids == k
-        Ra, ca = world_from(name, ta)
-        Rb, cb = world_from(name, tb)
-        out[sel] = ((P[sel] - ca) @ Ra) @ Rb.T + cb
-    return out
+    return SCENE.moved(P, ids, ta, tb)
 
 
 def state_in(P, present, K_rect, R, C, t):

@@ -5,14 +5,19 @@ Mitsuba, no scenegen camera or pose code), moves the hit point with poses it int
 (numpy lerp + scipy Slerp), projects with cv2.projectPoints and decides visibility by its own
 first-hit cast in frame b's scene. Flow (.flo and EXR), scene flow, occlusion states and point
 tracks of the dataset must agree."""
+import sys
+from pathlib import Path
+
 import cv2
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation, Slerp
 
 from scenegen.dataset.codecs import decode_flo, read_exr, read_json, read_tracks
 from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIBLE
 from scenegen.pipeline.run import render_spec
+
+sys.path.insert(0, str(Path(__file__).parent))
+from analytic_scene import SEQUENCE_SCENE, look, slerp_lerp  # noqa: E402
 
 pytestmark = [pytest.mark.render, pytest.mark.filterwarnings("ignore:invalid value:RuntimeWarning")]
 
@@ -71,72 +76,23 @@ views:
 """
 
 
-def _look(eye, target):
-    z = np.subtract(target, eye) / np.linalg.norm(np.subtract(target, eye))
-    x = np.cross(z, [0, 0, 1.0])
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], 1)  # world_from_cam rotation, OpenCV axes
-
-
-def _lin(t, t1, a, b, Ra, Rb):
-    """(R, p) by slerp and lerp between two keyframes at 0 and t1."""
-    u = min(max(t / t1, 0.0), 1.0)
-    R = Slerp([0, 1], Rotation.from_matrix(np.stack([Ra, Rb])))([u]).as_matrix()[0]
-    return R, (1 - u) * np.asarray(a, float) + u * np.asarray(b, float)
-
-
-def eul(*deg):
-    return Rotation.from_euler("xyz", deg, degrees=True).as_matrix()
+SCENE = SEQUENCE_SCENE  # the spec's objects, restated (tests/scenegen/pipeline/analytic_scene.py)
+IDS = SCENE.ids
+CAM_PATH = (0.0, 0.2, look([0.2, -1.8, 1.3], [0, 0, 0.1]), look([-0.2, -1.7, 1.4], [0, 0.05, 0.1]),
+            [0.2, -1.8, 1.3], [-0.2, -1.7, 1.4])
 
 
 def world_from(name, t):
-    """The test's own interpolation of each object (and the camera)."""
-    if name == "ball":
-        return _lin(t, 0.2, [-0.3, 0.1, 0.25], [0.3, -0.1, 0.35], np.eye(3), eul(0, 0, 40))
-    if name == "crate":
-        return _lin(t, 0.2, [0.35, 0.3, 0.125], [-0.2, 0.25, 0.2], eul(0, 0, 10), eul(20, 0, 80))
-    if name == "dice":
-        return np.eye(3), np.array([-0.45, -0.35, 0.075])
+    """The test's own interpolation of each object (and the camera) at one time."""
     if name == "cam":
-        return _lin(t, 0.2, [0.2, -1.8, 1.3], [-0.2, -1.7, 1.4], _look([0.2, -1.8, 1.3], [0, 0, 0.1]),
-                    _look([-0.2, -1.7, 1.4], [0, 0.05, 0.1]))
-    return np.eye(3), np.zeros(3)
-
-
-BOXES = {"crate": (0.15, 0.1, 0.125), "dice": (0.075, 0.075, 0.075)}
-IDS = {"floor": 1, "ball": 2, "crate": 3, "dice": 4}
+        R, c = slerp_lerp(t, *CAM_PATH)
+        return R[0], c[0]
+    return SCENE.pose(name, t)
 
 
 def first_hits(o, d, t):
     """(N,) distance and (N,) object id of the first hit of rays o + s d (float64, analytic)."""
-    n = len(d)
-    best = np.full(n, np.inf)
-    oid = np.zeros(n, np.int64)
-    o = np.broadcast_to(o, d.shape)
-
-    def take(s, name):
-        better = (s > 1e-9) & (s < best)
-        best[better] = s[better]
-        oid[better] = IDS[name]
-
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = -o[:, 2] / d[:, 2]
-        p = o + s[:, None] * d
-        take(np.where((np.abs(p[:, 0]) <= 2) & (np.abs(p[:, 1]) <= 2), s, np.inf), "floor")
-        _, c = world_from("ball", t)
-        oc = o - c
-        b = np.sum(oc * d, 1)
-        disc = b * b - (np.sum(oc * oc, 1) - 0.25 ** 2)
-        take(np.where(disc >= 0, -b - np.sqrt(np.maximum(disc, 0)), np.inf), "ball")
-        for name, half in BOXES.items():
-            if name == "dice" and not (0.15 <= t <= 1.0):
-                continue
-            R, c = world_from(name, t)
-            ol, dl = (o - c) @ R, d @ R
-            t1, t2 = (-np.asarray(half) - ol) / dl, (np.asarray(half) - ol) / dl
-            near, far = np.minimum(t1, t2).max(1), np.maximum(t1, t2).min(1)
-            take(np.where((near <= far) & (near > 0), near, np.inf), name)
-    return best, oid
+    return SCENE.first_hits(o, d, t)
 
 
 def camera(t):
@@ -161,13 +117,7 @@ def project(P, t):
 
 
 def moved(P, ids, ta, tb):
-    out = P.copy()
-    for name, k in IDS.items():
-        sel = ids == k
-        Ra, ca = world_from(name, ta)
-        Rb, cb = world_from(name, tb)
-        out[sel] = ((P[sel] - ca) @ Ra) @ Rb.T + cb
-    return out
+    return SCENE.moved(P, ids, ta, tb)
 
 
 def states_at(Pb, ids, tb):
