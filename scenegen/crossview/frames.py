@@ -72,13 +72,12 @@ def moving_ids(frames) -> set[int]:
     return out
 
 
-def _poses_at(frame: FrameGeometry, oid: int, rows):
-    """((M, 3, 3), (M, 3), (M,) present) world_from_object of ``oid`` at ``rows`` of ``frame``
-    (None: the frame's time)."""
+def _poses_at(frame: FrameGeometry, oid: int, rows, n: int):
+    """((n, 3, 3), (n, 3), (n,) present) world_from_object of ``oid`` at ``rows`` (n,) of
+    ``frame`` (None: the frame's time)."""
     if rows is not None and frame.rolling is not None and oid in frame.rolling.objects:
         return frame.rolling.object_pose(oid, rows)
     pose, present = frame.poses[oid]
-    n = 1 if rows is None else len(rows)
     return (np.broadcast_to(pose.R, (n, 3, 3)), np.broadcast_to(pose.t, (n, 3)), np.full(n, bool(present)))
 
 
@@ -91,7 +90,7 @@ def to_object(points_world, object_ids, frame: FrameGeometry, rows, movers) -> n
     for oid in movers:
         sel = np.flatnonzero(ids == oid)
         if len(sel):
-            R, t, _ = _poses_at(frame, oid, None if rows is None else rows[sel])
+            R, t, _ = _poses_at(frame, oid, None if rows is None else rows[sel], len(sel))
             X[sel] = np.einsum("nji,nj->ni", R, P[sel] - t)  # R^T (P - t)
     return X
 
@@ -105,7 +104,7 @@ def to_world(X, object_ids, frame: FrameGeometry, rows, movers) -> tuple[np.ndar
     for oid in movers:
         sel = np.flatnonzero(ids == oid)
         if len(sel):
-            R, t, pres = _poses_at(frame, oid, None if rows is None else rows[sel])
+            R, t, pres = _poses_at(frame, oid, None if rows is None else rows[sel], len(sel))
             P[sel] = np.einsum("nij,nj->ni", R, X[sel]) + t
             present[sel] = pres
     return P, present

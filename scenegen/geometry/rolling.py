@@ -4,8 +4,9 @@ Row ``v`` (continuous, OpenCV pixel rows, 0 = top) of a frame is exposed around
 ``tau(v) = Shutter.row_time_s(v, H)`` seconds from the frame's time (its middle row at 0; the one
 definition, :mod:`scenegen.geometry.optics`; the renderer's sensor times its samples by the same
 line). Poses within a frame (the camera's ``world_from_cam``, a moving object's
-``world_from_object``: a frame's rotation and its origin's path) are tabulated at the row centres from one row above the image to one below,
-nodes ``v = -1 .. H``: a pixel row's own pose is a node, exactly; between nodes a pose is
+``world_from_object``: a frame's rotation and its origin's path) are tabulated at the row
+centres from one row above the image to one below, nodes ``v = -1 .. H``: a pixel row's own
+pose is a node, exactly; between nodes a pose is
 interpolated along the geodesic (rotation ``R_k exp(a log(R_k^T R_k+1))``, translation linearly).
 Nodes are one row time apart (e.g. 12 ms / 239 rows = 50 us), where a trajectory accelerating at
 10 m/s^2 leaves the chord by ``a dt^2 / 8`` = 3e-9 m; a linear (lerp/slerp) path or a constant
@@ -26,7 +27,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.rotation import matrix_from_rotvec, rotvec_from_matrix
 
 #: A fixed point is reached when the row moves by less than this between iterations (pixels).
@@ -55,21 +55,6 @@ class RowPoses:
         # the geodesic step of each interval, in the frame of its first node
         object.__setattr__(self, "_w", rotvec_from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]))
 
-    @classmethod
-    def over_rows(cls, pose_at_row: Callable[[float], Rigid3], height: int) -> RowPoses:
-        """Nodes at rows -1 .. height of a frame ``height`` rows tall: ``pose_at_row(v)``."""
-        poses = [pose_at_row(float(v)) for v in range(-1, height + 1)]
-        return cls(np.stack([p.R for p in poses]), np.stack([p.t for p in poses]), -1.0)
-
-    @property
-    def rows(self) -> np.ndarray:
-        """(n,) the nodes' rows."""
-        return self.first_row + np.arange(len(self.R), dtype=np.float64)
-
-    def node(self, k: int) -> Rigid3:
-        """The pose at node ``k`` (row ``first_row + k``), exactly as tabulated."""
-        return Rigid3(self.R[k], self.t[k])
-
     def at(self, v) -> tuple[np.ndarray, np.ndarray]:
         """((N, 3, 3), (N, 3)) the poses at rows ``v`` (N,), interpolated between the nodes
         (module docstring); rows beyond the nodes take the end nodes' poses."""
@@ -79,11 +64,6 @@ class RowPoses:
         R = self.R[k] @ matrix_from_rotvec(a[:, None] * self._w[k]).reshape(-1, 3, 3)
         t = self.t[k] + a[:, None] * (self.t[k + 1] - self.t[k])
         return R, t
-
-    def apply(self, v, points) -> np.ndarray:
-        """(N, 3) ``points`` (N, 3) mapped by the pose at each point's row ``v`` (N,)."""
-        R, t = self.at(v)
-        return np.einsum("nij,nj->ni", R, np.asarray(points, np.float64)) + t
 
 
 @dataclass(frozen=True)
