@@ -17,6 +17,11 @@ from scenegen.imaging.stage import apply_imaging
 from scenegen.spec.timeline import poses_within_frame
 
 
+#: Rolling-shutter views whose row tables stay cached on the loaded scene (the render, the truth
+#: and the cross-view and sequence stages of a view ask for them in turn).
+ROWS_KEPT = 64
+
+
 def view_seed(seed: int, view_index: int) -> int:
     """Sampler seed of one view: distinct per view, fixed by (seed, index in the run) (uint32)."""
     return hashed_seed32(seed, view_index)
@@ -38,27 +43,31 @@ def rolling_rows(built, view) -> RollingRows | None:
 def _rows(built, view):
     """(per-row cam_from_world or None, RollingRows or None) of a view, cached on the scene: the
     truth pass's row poses are the table's nodes 0 .. H-1 themselves."""
+    shutter = getattr(built.optics.get(view.camera), "shutter", None)
+    camera_moves = view.motion is not None and not view.motion.is_static
+    if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
+        return None, None  # a global shutter, or nothing moves: nothing to tabulate (or keep)
     key = (view.name, getattr(view, "time_s", None))
-    if key not in built.view_rows:
-        shutter = getattr(built.optics.get(view.camera), "shutter", None)
-        camera_moves = view.motion is not None and not view.motion.is_static
-        if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
-            built.view_rows[key] = (None, None)
-        else:
-            H = built.cameras[view.camera].height
-            taus = shutter.row_time_s(np.arange(-1, H + 1, dtype=np.float64), H)
-            poses = row_poses(view.cam_from_world, view.motion, shutter, H) if camera_moves else None
-            edges = [cam_from_world_at(view.cam_from_world, view.motion, float(taus[k])) for k in (0, -1)]
-            cam = [edges[0], *(poses or [view.cam_from_world] * H), edges[1]]
-            world_from_cam = [p.inverse() for p in cam]
-            objects, present = {}, {}
-            if built.movers:
-                for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
-                    objects[oid], present[oid] = RowPoses(R, t, -1.0), p
-            rows = RollingRows(RowPoses(np.stack([p.R for p in world_from_cam]), np.stack([p.t for p in world_from_cam]),
-                                        -1.0), objects, present)
-            built.view_rows[key] = (poses, rows)
-    return built.view_rows[key]
+    cache = built.view_rows
+    if key in cache:
+        cache.move_to_end(key)
+    else:
+        H = built.cameras[view.camera].height
+        taus = shutter.row_time_s(np.arange(-1, H + 1, dtype=np.float64), H)
+        poses = row_poses(view.cam_from_world, view.motion, shutter, H) if camera_moves else None
+        edges = [cam_from_world_at(view.cam_from_world, view.motion, float(taus[k])) for k in (0, -1)]
+        cam = [edges[0], *(poses or [view.cam_from_world] * H), edges[1]]
+        world_from_cam = [p.inverse() for p in cam]
+        objects, present = {}, {}
+        if built.movers:
+            for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
+                objects[oid], present[oid] = RowPoses(R, t, -1.0), p
+        rows = RollingRows(RowPoses(np.stack([p.R for p in world_from_cam]), np.stack([p.t for p in world_from_cam]),
+                                    -1.0), objects, present)
+        cache[key] = (poses, rows)
+        while len(cache) > ROWS_KEPT:  # bounded: a long run renders each view once
+            cache.popitem(last=False)
+    return cache[key]
 
 
 def visibility_fn(built, view, rows: RollingRows | None):

@@ -7,6 +7,7 @@ camera (:mod:`.sensor`).
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import mitsuba as mi
@@ -55,7 +56,7 @@ class LoadedScene:
     entry_ids: tuple = ({}, {})  # (dict key -> object id, dict key -> instance id)
     movers: dict = field(default_factory=dict)  # object id -> spec object that moves within a frame
     timed_scenes: object = None  # render.timed.TimedScenes, made on first use (:meth:`timed`)
-    view_rows: dict = field(default_factory=dict)  # view name -> what the pipeline derived of its
+    view_rows: OrderedDict = field(default_factory=OrderedDict)  # view -> what the pipeline derived of its
     # rows (rolling-shutter poses, scenegen.pipeline.view): made once per view, not per truth call
 
     @property
