@@ -20,8 +20,8 @@ from scenegen.render.timed import first_hit, timed_first_hit, upload_moves
 
 
 #: Embree's coherent traversal for the visibility rays of a view's pixels: they leave one centre
-#: towards pixel-ordered points, and coherent mode casts them 1.5-2x faster (measured 10-21 ms
-#: against 17-32 ms for 640x480 rays of the demo scene). The hits are the same surfaces; only a ray
+#: towards pixel-ordered points, and coherent mode casts them 1.5x faster (measured 5.7 ms against
+#: 8.7 ms for 640x480 rays of the demo scene, idle machine). The hits are the same surfaces; only a ray
 #: that grazes an edge within float32 rounding may be decided differently (the state of one pixel
 #: of scenes/triangulation_baselines.yaml, whose point lies within the tolerance band).
 VISIBILITY_COHERENT = True
