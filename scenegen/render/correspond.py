@@ -39,13 +39,9 @@ def upload_points(points_world) -> tuple:
 def correspond_in_kernel(scene, points_world, camera, cam_from_world: Rigid3,
                          rel_tol: float = OCCLUSION_REL_TOL) -> Correspondence:
     """:func:`scenegen.crossview.correspondence.correspond` of the truth points (H, W, 3) of view
-    i (float64, NaN = no surface; or their :func:`upload_points` with ``points_world.shape``
-    given as ``(columns, (H, W))``) in view j, in one kernel."""
-    if isinstance(points_world, tuple) and len(points_world) == 2 and isinstance(points_world[1], tuple):
-        (X, Y, Z), (H, W) = points_world
-    else:
-        H, W = np.shape(points_world)[:2]
-        X, Y, Z = upload_points(points_world)
+    i (float32 as stored, or float64; NaN = no surface) in view j, in one kernel."""
+    H, W = np.shape(points_world)[:2]
+    X, Y, Z = upload_points(points_world)
     o64 = lambda x: dr.opaque(mi.Float64, float(x))  # noqa: E731 (opaque: no recompilation per pose)
     R = [[o64(cam_from_world.R[i, j]) for j in range(3)] for i in range(3)]
     t = [o64(c) for c in cam_from_world.t]
