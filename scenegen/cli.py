@@ -11,9 +11,7 @@ standard library, and ``validate`` no more than the spec parser (docs/performanc
 from __future__ import annotations
 
 import argparse
-import gc
 import json
-import shutil
 import sys
 import time
 import traceback
@@ -79,34 +77,11 @@ def cmd_render(args) -> int:
         if many:  # variants and/or Dask workers (scenegen/batch.py)
             summaries = render_many(args.spec, args.output, variants=args.variants,
                                     workers=args.workers, scheduler=args.scheduler, **kw)
-        else:
-            fresh = not args.output.exists()
-            try:
-                summaries = [render_spec(args.spec, args.output, **kw)]
-            except BaseException:
-                if fresh:
-                    _discard_unstarted(args.output)
-                raise
+        else:  # a failed run removes the folder only if it created it (DatasetWriter.discard)
+            summaries = [render_spec(args.spec, args.output, **kw)]
     for s in summaries:
         _print_summary(s)
     return 0
-
-
-def _discard_unstarted(out: Path) -> None:
-    """After a failed render into a folder this run created: remove it when no view was completed
-    in it, so the next run starts afresh instead of being told the folder is not empty. A folder
-    with completed views is kept: ``--resume`` finishes it."""
-    from scenegen.dataset.errors import DatasetError  # the command's implementation, on use
-    from scenegen.dataset.journal import load_current_manifest  # the command's implementation, on use
-    from scenegen.dataset.manifest import STATUS_COMPLETE  # the command's implementation, on use
-
-    gc.collect()  # drop the failed writer (and its lock) before looking
-    try:
-        done = [v for v, e in load_current_manifest(out)["views"].items() if e["status"] == STATUS_COMPLETE]
-    except (DatasetError, OSError, ValueError):
-        done = None if any(p.is_file() and not p.name.startswith(".") for p in out.rglob("*")) else []
-    if done == [] and out.is_dir():
-        shutil.rmtree(out, ignore_errors=True)
 
 
 def _print_summary(s) -> None:

@@ -88,6 +88,11 @@ class DatasetLock:
         self.path = path
         self._fd = fd
         self.taken_over = taken_over  # the stale owner's record, when the lock was taken over
+        #: True when :meth:`acquire` made the folder itself (``mkdir`` succeeded here): only then
+        #: may its owner remove the folder again (:meth:`DatasetWriter.discard
+        #: <scenegen.dataset.writer.DatasetWriter.discard>`). Deciding "fresh" by looking before
+        #: the lock is taken would let a refused second writer delete the live writer's folder.
+        self.created_root = False
 
     @classmethod
     def acquire(cls, root) -> "DatasetLock":
@@ -95,14 +100,22 @@ class DatasetLock:
         owner when a live process holds it; OSError (read-only, full disk) when the lock file
         cannot be written."""
         root = Path(root)
-        root.mkdir(parents=True, exist_ok=True)
+        try:
+            root.mkdir(parents=True)  # atomic: of two processes, exactly one creates the folder
+            created = True
+        except FileExistsError:
+            created = False
         path = root / LOCK_NAME
+        lock = None
         if fcntl is not None:
             for _ in range(20):  # retried only when an owner removed the file under us
                 lock = cls._try_flock(root, path)
                 if lock is not None:
-                    return lock
-        return cls._exclusive(root, path)
+                    break
+        if lock is None:
+            lock = cls._exclusive(root, path)
+        lock.created_root = created
+        return lock
 
     @classmethod
     def _try_flock(cls, root: Path, path: Path) -> "DatasetLock | None":

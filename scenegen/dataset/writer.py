@@ -9,8 +9,10 @@ whatever the order in which views were written.
 """
 from __future__ import annotations
 
+import os
 import platform
 import re
+import shutil
 from importlib import metadata
 from pathlib import Path
 from typing import Any, Mapping
@@ -341,6 +343,35 @@ class DatasetWriter:
             self._journal.close()
             self._journal = None
         self._lock.release()
+
+    def discard(self) -> bool:
+        """After a failure: remove the folder when this writer created it and completed no view
+        in it (so the next run starts afresh instead of being told the folder is not empty);
+        otherwise :meth:`abort` (``--resume`` finishes it). Returns True if the folder was removed.
+
+        Only a folder this writer's own ``mkdir`` created, and whose lock it has held since, is
+        removed: everything in it is this run's. It is first renamed out of the way (atomically,
+        the lock still held), so a writer starting meanwhile makes a new folder of its own
+        instead of finding this one half deleted.
+        """
+        if self._lock.path is None or not self._lock.created_root or self.completed_views:
+            self.abort()
+            return False
+        if self._journal is not None:
+            self._journal.close()
+            self._journal = None
+        doomed = self.root.with_name(f".{self.root.name}.discarded-{os.getpid()}-{id(self):x}")
+        try:
+            os.rename(self.root, doomed)
+        except OSError:
+            self.abort()
+            return False
+        self._lock.path = doomed / LOCK_NAME  # release must not unlink a new writer's lock file
+        try:
+            shutil.rmtree(doomed, ignore_errors=True)
+        finally:
+            self._lock.release()
+        return True
 
     def __enter__(self) -> "DatasetWriter":
         return self

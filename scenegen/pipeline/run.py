@@ -108,6 +108,21 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     run_hash = hashlib.sha256((spec_sha256(spec) + json.dumps(used.__dict__, sort_keys=True)).encode()).hexdigest()
     writer = DatasetWriter(out_dir, spec_sha256=run_hash, seed=seed, variant=used.variant,
                            versions=software_versions(), resume=resume)
+    try:
+        rendered, todo, skipped = _write_dataset(spec, views, wanted, built, writer, used, source or spec_path,
+                                                 dask_client=dask_client, progress=progress)
+    except BaseException:
+        writer.discard()  # the folder goes only if this run created it and completed nothing in it
+        raise
+    return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)
+
+
+def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: RenderSettingsUsed, source, *,
+                   dask_client, progress: bool) -> tuple[int, list, int]:
+    """Everything :func:`render_spec` writes once the folder is locked: cameras.json, meshes,
+    targets, the views, the cross-view and sequence stages; then the manifest is compacted.
+    Returns (views rendered, views selected, views already complete)."""
+    spp, seed = used.spp, used.seed
     view_cams = {v.name: ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
                                        frame_index=v.frame_index, optics=view_optics(built, v),
@@ -135,9 +150,9 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
         for _ in range(skipped):
             bar.advance()
         if dask_client is not None:  # workers render and write; recorded here in the run's order
-            rendered = render_views_dask(
-                dask_client, source or SpecSource.from_path(spec_path), writer, pending, spp=spp,
-                seed=seed, variant=used.variant, on_done=bar.advance)
+            source = source if isinstance(source, SpecSource) else SpecSource.from_path(source)
+            rendered = render_views_dask(dask_client, source, writer, pending, spp=spp, seed=seed,
+                                         variant=used.variant, on_done=bar.advance)
         else:  # a view is encoded and written on a thread while the next one renders
             with BackgroundWriter(writer) as background:
                 for index, v in pending:
@@ -149,4 +164,4 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     run_crossview(spec, views, built, writer, spp=spp, seed=seed, progress=progress)  # docs/crossview.md
     run_sequence(spec, views, built, writer)  # truth across time of a sequence (docs/crossview.md)
     writer.close()
-    return RenderSummary(Path(out_dir), len(todo), rendered, skipped, time.perf_counter() - t0, used)
+    return rendered, todo, skipped

@@ -200,3 +200,14 @@ def test_kill_9_mid_render_then_resume_takes_over_the_stale_lock_and_gives_the_b
     assert (out / LOCK_NAME).is_file()  # left by the killed run: stale
     assert main(["render", str(spec), "-o", str(out), "--resume", "-q"]) == 0
     assert all_bytes(out) == all_bytes(ref)
+
+
+def test_discard_removes_only_a_folder_its_writer_created(tmp_path):
+    made = tmp_path / "made"
+    w = new_writer(made)
+    assert w.discard() and not made.exists()  # created here, nothing completed: gone
+    existing = tmp_path / "existing"
+    existing.mkdir()
+    w = new_writer(existing)
+    assert not w.discard() and sorted(p.name for p in existing.iterdir()) == ["manifest.json"]
+    assert not list(tmp_path.glob(".*"))  # no residue of the discarded folder
