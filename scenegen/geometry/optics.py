@@ -50,6 +50,11 @@ class Shutter:
             return 0.0 * np.asarray(v, dtype=np.float64)
         return self.rolling_readout_s * (np.asarray(v, dtype=np.float64) / (height - 1) - 0.5)
 
+    def row_of_time(self, tau_s, height: int):
+        """The row (px, continuous) exposed ``tau_s`` seconds from the middle row: the inverse of
+        :meth:`row_time_s` (a rolling shutter only)."""
+        return (np.asarray(tau_s, dtype=np.float64) / self.rolling_readout_s + 0.5) * (height - 1)
+
 
 @dataclass(frozen=True, kw_only=True)
 class Motion:
@@ -87,6 +92,11 @@ class PathMotion:
     @property
     def is_static(self) -> bool:
         return False
+
+    @property
+    def knot_taus_s(self) -> np.ndarray:
+        """(K,) seconds from the frame time at which the path's velocity may jump (its keyframes)."""
+        return np.asarray(getattr(self.trajectory, "knot_times_s", ()), np.float64) - self.time_s
 
     def world_from_cam(self, tau_s: float) -> Rigid3:
         return self.trajectory.pose(self.time_s + float(tau_s)) @ self.x_from_cam

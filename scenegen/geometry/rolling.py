@@ -5,12 +5,15 @@ Row ``v`` (continuous, OpenCV pixel rows, 0 = top) of a frame is exposed around
 definition, :mod:`scenegen.geometry.optics`; the renderer's sensor times its samples by the same
 line). Poses within a frame (the camera's ``world_from_cam``, a moving object's
 ``world_from_object``: a frame's rotation and its origin's path) are tabulated at the row
-centres from one row above the image to one below, nodes ``v = -1 .. H``: a pixel row's own
-pose is a node, exactly; between nodes a pose is
+centres from one row above the image to one below, nodes ``v = -1 .. H``, plus a node (a knot)
+at the row of every keyframe time that falls inside the frame's readout, where a path's velocity
+may jump (a linear path's keyframes, the held pose before the first and after the last one): a
+pixel row's own pose is a node, exactly; between nodes a pose is
 interpolated along the geodesic (rotation ``R_k exp(a log(R_k^T R_k+1))``, translation linearly).
-Nodes are one row time apart (e.g. 12 ms / 239 rows = 50 us), where a trajectory accelerating at
-10 m/s^2 leaves the chord by ``a dt^2 / 8`` = 3e-9 m; a linear (lerp/slerp) path or a constant
-velocity is interpolated exactly, up to rounding.
+Nodes are at most one row time apart (e.g. 12 ms / 239 rows = 50 us), where a trajectory
+accelerating at 10 m/s^2 leaves the chord by ``a dt^2 / 8`` = 3e-9 m; a linear (lerp/slerp) path
+or a constant velocity is interpolated exactly, up to rounding, kinks included (without the knots
+an interval straddling a kink would cut the corner: 0.19 mm on a 3.7 m/s path, issue 26).
 
 A rolling-shutter camera sees a point where the row that images it is exposed: ``v`` solving
 ``v = row(project(cam_from_world(v) @ P(v)))``, with ``P(v)`` the point at that row's time (it
@@ -37,33 +40,63 @@ MAX_ITERATIONS = 60
 
 @dataclass(frozen=True, eq=False)
 class RowPoses:
-    """Rigid poses at the row nodes ``v = first_row + k`` (k = 0 .. n-1) of one frame.
+    """Rigid poses at the row nodes of one frame: ``first_row + k`` (k = 0 .. n-1), or the
+    strictly increasing rows ``node_rows`` (n,) (uniform nodes with knots, module docstring).
 
     ``R`` (n, 3, 3), ``t`` (n, 3): the pose (x_from_y, any pair of frames) at each node."""
 
     R: np.ndarray
     t: np.ndarray
     first_row: float = -1.0
+    node_rows: np.ndarray | None = None
 
     def __post_init__(self):
         R, t = np.asarray(self.R, np.float64), np.asarray(self.t, np.float64)
         if R.ndim != 3 or R.shape[1:] != (3, 3) or t.shape != (len(R), 3) or len(R) < 2:
             raise ValueError(f"RowPoses: need (n, 3, 3) rotations and (n, 3) translations, n >= 2; "
                              f"got {R.shape} and {t.shape}")
+        rows = (self.first_row + np.arange(len(R), dtype=np.float64) if self.node_rows is None
+                else np.asarray(self.node_rows, np.float64))
+        if rows.shape != (len(R),) or np.any(np.diff(rows) <= 0):
+            raise ValueError(f"RowPoses: node_rows must be {len(R)} strictly increasing rows")
         object.__setattr__(self, "R", R)
         object.__setattr__(self, "t", t)
+        object.__setattr__(self, "first_row", float(rows[0]))
+        object.__setattr__(self, "node_rows", rows)
+        # node positions from the first; integers for uniform nodes, so that the interval
+        # arithmetic below is the plain floor/fraction of a uniform table
+        object.__setattr__(self, "_f", rows - rows[0])
         # the geodesic step of each interval, in the frame of its first node
         object.__setattr__(self, "_w", rotvec_from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]))
+
+    def interval(self, v) -> tuple[np.ndarray, np.ndarray]:
+        """((N,) node index k, (N,) fraction a in [0, 1]) of rows ``v`` (N,): v lies between nodes
+        k and k + 1 (rows beyond the nodes are clamped to the end nodes)."""
+        f = np.clip(np.asarray(v, np.float64) - self.first_row, 0.0, self._f[-1])
+        k = np.minimum(np.searchsorted(self._f, f, side="right") - 1, len(self._f) - 2)
+        return k, (f - self._f[k]) / (self._f[k + 1] - self._f[k])
+
+    def nearest_node(self, v) -> np.ndarray:
+        """(N,) index of the node nearest to each of rows ``v`` (N,) (a tie: the lower node)."""
+        k, a = self.interval(v)
+        return k + (a > 0.5)
 
     def at(self, v) -> tuple[np.ndarray, np.ndarray]:
         """((N, 3, 3), (N, 3)) the poses at rows ``v`` (N,), interpolated between the nodes
         (module docstring); rows beyond the nodes take the end nodes' poses."""
-        f = np.clip(np.asarray(v, np.float64) - self.first_row, 0.0, len(self.R) - 1.0)
-        k = np.minimum(np.floor(f).astype(np.int64), len(self.R) - 2)
-        a = f - k
+        k, a = self.interval(v)
         R = self.R[k] @ matrix_from_rotvec(a[:, None] * self._w[k]).reshape(-1, 3, 3)
         t = self.t[k] + a[:, None] * (self.t[k + 1] - self.t[k])
         return R, t
+
+
+def frame_node_rows(shutter, height: int, knot_taus_s) -> np.ndarray:
+    """(n,) the node rows of a rolling-shutter frame: -1 .. H, plus the rows of ``knot_taus_s``
+    (seconds from the frame time; module docstring) that lie strictly inside and are no node yet."""
+    rows = np.arange(-1, height + 1, dtype=np.float64)
+    knots = shutter.row_of_time(np.asarray(knot_taus_s, np.float64), height)
+    knots = knots[(knots > rows[0]) & (knots < rows[-1]) & (knots != np.round(knots))]
+    return np.union1d(rows, knots)
 
 
 @dataclass(frozen=True)
@@ -123,7 +156,7 @@ def rolling_project(camera, world_from_cam: RowPoses,
 class RollingRows:
     """A rolling-shutter frame in which something moves: the camera's ``world_from_cam`` and
     every moving object's ``world_from_object`` (object id -> :class:`RowPoses`, with ``present``
-    (n,) per node) at the row nodes -1 .. H."""
+    (n,) per node) at the frame's row nodes (:func:`frame_node_rows`, the same for all)."""
 
     cam: RowPoses
     objects: dict
@@ -131,11 +164,11 @@ class RollingRows:
 
     @property
     def height(self) -> int:
-        return len(self.cam.R) - 2
+        return int(self.cam.node_rows[-1])  # the last node is row H
 
-    def pixel_rows(self) -> slice:
-        """The nodes of the image's rows 0 .. H-1."""
-        return slice(1, self.height + 1)
+    def pixel_rows(self) -> np.ndarray:
+        """The node indices of the image's rows 0 .. H-1."""
+        return np.searchsorted(self.cam.node_rows, np.arange(self.height, dtype=np.float64))
 
     def object_moves(self, rows=None) -> dict:
         """{object id: ((N, 3, 3) R, (N, 3) t world_from_object, (N,) present)} at ``rows`` (N,)
@@ -149,5 +182,4 @@ class RollingRows:
         """((N, 3, 3) R, (N, 3) t world_from_object, (N,) present) of one moving object at
         ``rows`` (N,): interpolated; present at the nearest node."""
         rows = np.asarray(rows, np.float64)
-        near = np.clip(np.rint(rows - self.cam.first_row), 0, len(self.cam.R) - 1).astype(np.int64)
-        return (*self.objects[object_id].at(rows), self.present[object_id][near])
+        return (*self.objects[object_id].at(rows), self.present[object_id][self.cam.nearest_node(rows)])

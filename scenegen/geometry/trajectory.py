@@ -156,6 +156,12 @@ class KeyframeTrajectory:
     def __len__(self) -> int:
         return len(self.poses)
 
+    @property
+    def knot_times_s(self) -> np.ndarray:
+        """(K,) the keyframe times: where the interpolation's velocity may jump (every keyframe
+        of a linear path; the held ends of a spline), so tables over time must have nodes there."""
+        return self.times_s
+
     def state(self, t_s: float) -> MotionState:
         """Pose and world-frame derivatives at ``t_s`` (see the module docstring)."""
         t = float(t_s)
@@ -202,6 +208,11 @@ class JointTrajectory:
         self.interpolation, self.rest = interpolation, rest
         self._q = (_cubic_spline()(self.times_s, self.values, bc_type="natural")
                    if len(self.values) >= 2 and interpolation == "spline" else None)
+
+    @property
+    def knot_times_s(self) -> np.ndarray:
+        """(K,) the keyframe times (see :attr:`KeyframeTrajectory.knot_times_s`)."""
+        return self.times_s
 
     def _q_derivatives(self, t: float) -> tuple[float, float, float]:
         T, q = self.times_s, self.values

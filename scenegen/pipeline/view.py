@@ -10,8 +10,8 @@ import numpy as np
 
 from scenegen.crossview.correspondence import correspond
 from scenegen.geometry.color import srgb_image
-from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict, row_poses
-from scenegen.geometry.rolling import RollingRows, RowPoses
+from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict
+from scenegen.geometry.rolling import RollingRows, RowPoses, frame_node_rows
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.imaging.stage import apply_imaging
 from scenegen.spec.timeline import poses_within_frame
@@ -53,17 +53,22 @@ def _rows(built, view):
         cache.move_to_end(key)
     else:
         H = built.cameras[view.camera].height
-        taus = shutter.row_time_s(np.arange(-1, H + 1, dtype=np.float64), H)
-        poses = row_poses(view.cam_from_world, view.motion, shutter, H) if camera_moves else None
-        edges = [cam_from_world_at(view.cam_from_world, view.motion, float(taus[k])) for k in (0, -1)]
-        cam = [edges[0], *(poses or [view.cam_from_world] * H), edges[1]]
+        time_s = getattr(view, "time_s", None)
+        knots = [view.motion.knot_taus_s] if isinstance(view.motion, PathMotion) else []
+        if built.movers and time_s is not None:
+            knots.append(built.timeline.knot_times_s() - time_s)
+        nodes = frame_node_rows(shutter, H, np.concatenate(knots) if knots else ())
+        taus = shutter.row_time_s(nodes, H)
+        pixel = np.searchsorted(nodes, np.arange(H, dtype=np.float64))
+        cam = [cam_from_world_at(view.cam_from_world, view.motion, float(tau)) for tau in taus]
+        poses = [cam[k] for k in pixel] if camera_moves else None
         world_from_cam = [p.inverse() for p in cam]
         objects, present = {}, {}
         if built.movers:
-            for oid, (R, t, p) in poses_within_frame(built.timeline, getattr(view, "time_s", None), taus).items():
-                objects[oid], present[oid] = RowPoses(R, t, -1.0), p
+            for oid, (R, t, p) in poses_within_frame(built.timeline, time_s, taus).items():
+                objects[oid], present[oid] = RowPoses(R, t, node_rows=nodes), p
         rows = RollingRows(RowPoses(np.stack([p.R for p in world_from_cam]), np.stack([p.t for p in world_from_cam]),
-                                    -1.0), objects, present)
+                                    node_rows=nodes), objects, present)
         cache[key] = (poses, rows)
         while len(cache) > ROWS_KEPT:  # bounded: a long run renders each view once
             cache.popitem(last=False)

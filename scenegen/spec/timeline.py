@@ -93,6 +93,17 @@ class Timeline:
     def states(self, t_s: float) -> dict[str, ObjectState]:
         return object_states(self.objects, t_s, trajectories=self._cache)
 
+    def knot_times_s(self) -> np.ndarray:
+        """(K,) sorted times at which some object's motion may have a velocity jump (its own or
+        a parent's keyframes, :attr:`scenegen.geometry.trajectory.KeyframeTrajectory.knot_times_s`)."""
+        times = []
+        for obj in self.objects:
+            if is_animated(obj):
+                if obj.name not in self._cache:
+                    self._cache[obj.name] = local_trajectory(obj.animation)
+                times.append(np.asarray(getattr(self._cache[obj.name], "knot_times_s", ()), np.float64))
+        return np.unique(np.concatenate(times)) if times else np.empty(0)
+
     def poses_by_id(self, t_s: float) -> dict[int, tuple[Rigid3, bool]]:
         """{object id: (world_from_object, present)} at ``t_s``."""
         s = self.states(t_s)

@@ -115,3 +115,31 @@ def test_from_a_global_shutter_frame_into_a_rolling_one():
         want_c = cam_from_world_at(POSE, CAM_MOTION, float(tau_of(rows[k]))).inverse().t
         assert np.abs(centres[k] - want_c).max() < 1e-12
         assert np.abs(points[k] - obj_world_from(float(tau_of(rows[k]))).apply(X[k][None])[0]).max() < 1e-12
+
+
+@pytest.mark.parametrize("with_knots", [True, False])
+def test_row_table_across_a_keyframe_kink_equals_the_exact_path(with_knots):
+    """A camera at 3.7 m/s on a two-keyframe linear path, the frame at its first keyframe: rows
+    above the middle hold the first pose (the clamp), rows below move. With the keyframe as a knot
+    the table equals the path evaluated directly at every row's time; without it the interval
+    that straddles the kink cuts the corner (the issue-26 defect: the test can fail)."""
+    from scenegen.geometry.optics import PathMotion
+    from scenegen.geometry.rolling import frame_node_rows
+    from scenegen.geometry.trajectory import KeyframeTrajectory
+    start, end = look_at([0.55, -1.9, 1.2], [0, 0, 0.1]), look_at([-0.55, -1.7, 1.3], [0, 0.05, 0.1])
+    path = KeyframeTrajectory([0.0, 0.3], [start, end], interpolation="linear")
+    motion = PathMotion(trajectory=path, time_s=0.0)
+    shutter, h = Shutter(rolling_readout_s=0.03), 60  # the kink at the middle row 29.5, between nodes
+    nodes = frame_node_rows(shutter, h, motion.knot_taus_s if with_knots else ())
+    assert (29.5 in nodes) == with_knots and len(nodes) == h + 2 + with_knots
+    poses = [motion.world_from_cam(float(t)) for t in shutter.row_time_s(nodes, h)]
+    table = RowPoses(np.stack([p.R for p in poses]), np.stack([p.t for p in poses]), node_rows=nodes)
+    v = np.linspace(-0.5, h - 0.5, 1201)
+    R, C = table.at(v)
+    want = [motion.world_from_cam(float(t)) for t in shutter.row_time_s(v, h)]
+    err_t = max(np.abs(C[k] - w.t).max() for k, w in enumerate(want))
+    err_R = max(np.abs(R[k] - w.R).max() for k, w in enumerate(want))
+    if with_knots:
+        assert err_t < 1e-12 and err_R < 1e-12
+    else:
+        assert err_t > 1e-5  # metres: a quarter of a row time at 3.7 m/s
