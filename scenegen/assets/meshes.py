@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from scenegen.assets import cache, shapes, targets, textures
+from scenegen.assets import blob, cache, shapes, targets, textures
 
 #: Spec geometry kind -> its object-frame mesh (all centred on the object origin).
 OBJECT_MESHES = {
@@ -76,9 +76,9 @@ def texture_image(texture) -> np.ndarray:
 
 
 def cached_blob(radius, amplitude, frequency, seed, subdivisions) -> trimesh.Trimesh:
-    """:func:`scenegen.assets.shapes.blob`, made once per content hash (:mod:`scenegen.assets.cache`)."""
+    """:func:`scenegen.assets.blob.blob`, made once per content hash (:mod:`scenegen.assets.cache`)."""
     def make():
-        m = shapes.blob(radius, amplitude, frequency, seed, subdivisions)
+        m = blob.blob(radius, amplitude, frequency, seed, subdivisions)
         return {"vertices": m.vertices, "faces": m.faces, "uv": m.visual.uv}
 
     key = {"radius": radius, "amplitude": amplitude, "frequency": frequency, "seed": seed,

@@ -21,7 +21,8 @@ from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION
 from scenegen.dataset.reader import Dataset
 from scenegen.dataset.truth import TRUTH_KEYS, check_truth
 from scenegen.dataset.verify import VerifyReport, verify
-from scenegen.dataset.writer import DatasetWriter, encode_view, software_versions, write_view_files
+from scenegen.dataset.view_files import encode_view, software_versions, write_view_files
+from scenegen.dataset.writer import DatasetWriter
 
 __all__ = [
     "CAMERAS", "MANIFEST", "FORMAT", "FORMAT_VERSION", "TRUTH_KEYS", "DatasetError", "DatasetMismatchError",

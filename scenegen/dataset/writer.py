@@ -1,4 +1,5 @@
-"""Writing a dataset: encode a view's files, write them atomically, hash them, keep the manifest.
+"""Writing a dataset: a view's files (encoded by :mod:`.view_files`) written atomically and
+hashed, the manifest kept.
 
 Crash safety: every file is written atomically (:mod:`scenegen.dataset.files`), and a view is
 recorded as ``complete`` (one fsync'd line of the manifest's journal, :mod:`.journal`, compacted
@@ -10,21 +11,16 @@ whatever the order in which views were written.
 from __future__ import annotations
 
 import os
-import platform
 import re
 import shutil
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Mapping
 
-import cv2
 import numpy as np
 
 from scenegen.dataset.cameras import ViewCamera, cameras_document
-from scenegen.dataset.codecs.exr import encode_exr, pack_channels
 from scenegen.dataset.codecs.json import decode_json, encode_json
 from scenegen.dataset.codecs.ply import encode_ply
-from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
 from scenegen.dataset.files import atomic_write_bytes, atomic_write_files, remove_stale_temp_files, sha256_bytes
 from scenegen.dataset.journal import (
@@ -54,80 +50,7 @@ from scenegen.dataset.manifest import (
     load_manifest,
     manifest_bytes_and_sha256,
 )
-from scenegen.dataset.truth import LINEAR_CHANNELS, encode_truth
-
-
-def encode_view(view: str, *, image: np.ndarray, linear_rgb: np.ndarray,
-                truth: Mapping[str, np.ndarray]) -> dict[str, bytes]:
-    """Encode one view's files: ``{relative path: bytes}`` (pure; writes nothing).
-
-    image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16 (the rendered, possibly corrupted image).
-    linear_rgb: (H, W, 3) float, clean linear radiance (stored as float32).
-    truth: see :func:`check_truth`.
-    """
-    paths = view_paths(view)
-    image = np.asarray(image)
-    hw = image.shape[:2]
-    linear_rgb = np.asarray(linear_rgb)
-    if not np.issubdtype(linear_rgb.dtype, np.floating) or linear_rgb.shape != hw + (3,):
-        raise ValueError(f"linear_rgb must be a float {hw + (3,)} array, got {linear_rgb.dtype}"
-                         f" {linear_rgb.shape}")
-    linear_rgb = linear_rgb.astype(np.float32, copy=False)
-    truth_files = encode_truth(truth, shape=hw)
-    return {
-        paths["image"]: encode_png(image),
-        paths["linear"]: encode_exr(pack_channels("", linear_rgb, LINEAR_CHANNELS)),
-        **{paths[k]: data for k, data in truth_files.items()},
-    }
-
-
-def _checked_extra_files(view: str, extra_files: Mapping[str, bytes] | None,
-                         standard: Mapping[str, Any]) -> dict[str, bytes]:
-    extra = {}
-    for rel, data in (extra_files or {}).items():
-        check_rel_path(rel)
-        if rel in standard or rel == CAMERAS:
-            raise ValueError(f"extra file {rel!r} of view {view!r} collides with a standard file")
-        if not isinstance(data, (bytes, bytearray, memoryview)):
-            raise TypeError(f"extra file {rel!r}: pass encoded bytes (see scenegen.dataset.codecs)")
-        extra[rel] = bytes(data)
-    return extra
-
-
-def write_view_files(out_dir, view: str, *, image, linear_rgb, truth,
-                     extra_files: Mapping[str, bytes] | None = None) -> dict[str, str]:
-    """Write one view's files atomically under ``out_dir``; return ``{relative path: sha256}``.
-
-    Does not touch the manifest: for a worker process, whose result the process owning the
-    :class:`DatasetWriter` then records with :meth:`DatasetWriter.record_view`.
-    ``extra_files`` maps further relative paths to encoded bytes, hashed and listed with the view.
-    """
-    files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
-    files.update(_checked_extra_files(view, extra_files, files))
-    root = Path(out_dir)
-    hashes = {rel: sha256_bytes(data) for rel, data in files.items()}
-    atomic_write_files({root / rel: data for rel, data in files.items()})
-    return hashes
-
-
-def software_versions() -> dict[str, str]:
-    """Versions of the software that determine the output bytes (without importing Mitsuba)."""
-    def dist_version(name: str) -> str:
-        try:
-            return metadata.version(name)
-        except metadata.PackageNotFoundError:
-            return "not installed"
-
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "opencv": cv2.__version__,
-        "mitsuba": dist_version("mitsuba"),
-        "drjit": dist_version("drjit"),
-        "openexr": dist_version("OpenEXR"),
-        "trimesh": dist_version("trimesh"),
-        "scenegen": dist_version("scenegen"),
-    }
+from scenegen.dataset.view_files import checked_extra_files, encode_view
 
 
 class DatasetWriter:
@@ -279,7 +202,7 @@ class DatasetWriter:
         Arguments as in :func:`encode_view`; ``extra_files`` as in :func:`write_view_files`.
         """
         files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
-        files.update(_checked_extra_files(view, extra_files, files))
+        files.update(checked_extra_files(view, extra_files, files))
         hashes = {rel: sha256_bytes(d) for rel, d in files.items()}
         self._check_rerecord(view, hashes)  # before writing anything
         atomic_write_files({self.root / rel: data for rel, data in files.items()})  # durable, then recorded

@@ -4,7 +4,7 @@ The client (the process owning the :class:`~scenegen.dataset.writer.DatasetWrite
 per frame (a rig's members share a frame) of one scene; a worker builds the scene the first time
 it sees ``(spec, variant, spp, Mitsuba variant)`` and keeps it (:data:`_SCENES`, the last
 :data:`SCENES_KEPT` scenes), renders the frame's views, writes their files with
-:func:`scenegen.dataset.writer.write_view_files` and returns the hashes. The client records each
+:func:`scenegen.dataset.view_files.write_view_files` and returns the hashes. The client records each
 view with :meth:`~scenegen.dataset.writer.DatasetWriter.record_views` in the run's order (every frame
 already done at once: one fsync'd batch of journal lines), so the manifest is
 byte-identical to a serial run's, and a run killed at any point resumes like a serial one. A
@@ -23,7 +23,7 @@ from collections import OrderedDict
 from pathlib import Path
 
 from scenegen.dataset.files import remove_stale_temp_files
-from scenegen.dataset.writer import write_view_files
+from scenegen.dataset.view_files import write_view_files
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import configure_llvm, load_scene
 from scenegen.spec import resolve_views

@@ -14,7 +14,8 @@ from scenegen.dataset.cameras import ViewCamera
 from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.layout import target_path
 from scenegen.dataset.targets import target_document
-from scenegen.dataset.writer import DatasetWriter, software_versions
+from scenegen.dataset.view_files import software_versions
+from scenegen.dataset.writer import DatasetWriter
 from scenegen.imaging.stage import imaging_record, raw_view_record
 from scenegen.pipeline.crossview import run_crossview
 from scenegen.pipeline.distributed import render_views_dask

@@ -117,7 +117,7 @@ def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
 
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
-    :func:`scenegen.dataset.writer.encode_view`; ``index`` is the view's position in the run."""
+    :func:`scenegen.dataset.view_files.encode_view`; ``index`` is the view's position in the run."""
     built.set_time(getattr(v, "time_s", None))  # a sequence's frame: its objects at its time
     linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
                           light_scales=v.light_scales)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from scenegen.assets import cache, meshes, shapes, textures
+from scenegen.assets import blob, cache, meshes, shapes, textures
 from scenegen.spec import parse_spec
 
 SPEC = """
@@ -34,7 +34,7 @@ def test_texture_and_blob_hits_are_bitwise_fresh(disk, monkeypatch):
     tex = obj.material.texture
     fresh_tex = textures.make_texture(tex.kind, dict(tex.params), tex.seed)
     g = obj.geometry
-    fresh = shapes.blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions)
+    fresh = blob.blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions)
     for _ in range(2):  # made (and stored), then from memory
         img = meshes.texture_image(tex)
         assert img.dtype == fresh_tex.dtype and img.tobytes() == fresh_tex.tobytes() and not img.flags.writeable

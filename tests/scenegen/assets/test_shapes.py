@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from scenegen.assets import shapes
+from scenegen.assets import blob, shapes
 
 # Exact-arithmetic checks (closed-form polyhedron volumes) are floored by float64 summation over a
 # few thousand triangles: ~1e-15 relative per term.
@@ -38,7 +38,7 @@ ALL_SHAPES = {
     "sphere": lambda: shapes.sphere(0.7, 24),
     "cylinder": lambda: shapes.cylinder(0.5, 2.0, 48),
     "torus": lambda: shapes.torus(1.0, 0.3, 48, 20),
-    "blob": lambda: shapes.blob(1.0, 0.3, 1.5, 7, 3),
+    "blob": lambda: blob.blob(1.0, 0.3, 1.5, 7, 3),
 }
 CLOSED = [k for k in ALL_SHAPES if k != "plane"]
 
@@ -184,24 +184,24 @@ class TestTorus:
 
 class TestBlob:
     def test_seed_determinism(self):
-        a = shapes.blob(1.0, 0.3, 2.0, seed=5, subdivisions=3)
-        b = shapes.blob(1.0, 0.3, 2.0, seed=5, subdivisions=3)
-        c = shapes.blob(1.0, 0.3, 2.0, seed=6, subdivisions=3)
+        a = blob.blob(1.0, 0.3, 2.0, seed=5, subdivisions=3)
+        b = blob.blob(1.0, 0.3, 2.0, seed=5, subdivisions=3)
+        c = blob.blob(1.0, 0.3, 2.0, seed=6, subdivisions=3)
         assert a.vertices.tobytes() == b.vertices.tobytes()
         assert a.faces.tobytes() == b.faces.tobytes()
         assert a.visual.uv.tobytes() == b.visual.uv.tobytes()
         assert not np.allclose(a.vertices, c.vertices)
 
     def test_radius_bounds_and_zero_amplitude(self):
-        m = shapes.blob(2.0, 0.25, 1.0, seed=1, subdivisions=3)
+        m = blob.blob(2.0, 0.25, 1.0, seed=1, subdivisions=3)
         d = np.linalg.norm(m.vertices, axis=1)
         assert d.min() >= 2.0 * 0.75 - 1e-12 and d.max() <= 2.0 * 1.25 + 1e-12
         assert d.max() - d.min() > 0.2  # it is displaced
-        flat = shapes.blob(2.0, 0.0, 1.0, seed=1, subdivisions=3)
+        flat = blob.blob(2.0, 0.0, 1.0, seed=1, subdivisions=3)
         assert np.allclose(np.linalg.norm(flat.vertices, axis=1), 2.0)
 
     def test_uv_from_spherical_coords(self):
-        m = shapes.blob(1.0, 0.3, 1.0, seed=2, subdivisions=3)
+        m = blob.blob(1.0, 0.3, 1.0, seed=2, subdivisions=3)
         p = m.vertices / np.linalg.norm(m.vertices, axis=1, keepdims=True)
         assert np.allclose(m.visual.uv[:, 1], np.arccos(np.clip(p[:, 2], -1, 1)) / np.pi)
         ok = (np.hypot(p[:, 0], p[:, 1]) > 1e-9) & ~((np.abs(p[:, 1]) < 1e-12) & (p[:, 0] > 0))
@@ -209,13 +209,13 @@ class TestBlob:
         assert np.allclose(m.visual.uv[ok, 0], phi / (2 * np.pi))
 
     def test_zero_amplitude_volume_within_inscribed_bound(self):
-        m = shapes.blob(1.0, 0.0, 1.0, seed=0, subdivisions=4)
+        m = blob.blob(1.0, 0.0, 1.0, seed=0, subdivisions=4)
         tol = 1 - _inscribed_cos_alpha(m, 1.0) ** 3
         assert 0 <= 1 - m.volume / (4 / 3 * np.pi) <= tol
 
     def test_rejects_amplitude_one(self):
         with pytest.raises(ValueError, match="amplitude"):
-            shapes.blob(amplitude=1.0)
+            blob.blob(amplitude=1.0)
 
 
 # --- loading files ---------------------------------------------------------------------------
