@@ -7,7 +7,9 @@ knows paths (docs/dataset_format.md, docs/crossview.md).
 * :mod:`.files`: atomic writes and SHA-256;
 * :mod:`.manifest`, :mod:`.cameras`, :mod:`.truth`, :mod:`.crossview`: what each file holds;
 * :mod:`.writer`: :class:`DatasetWriter` (atomic, hashed, resumable), with :mod:`.journal`
-  (the manifest's append-only journal while a run writes);
+  (the manifest's append-only journal while a run writes) and :mod:`.view_files` (a view's files);
+* :mod:`.streams`: sensor streams beside the views (schema, chunks), written by
+  :class:`StreamWriter` (:mod:`.stream_writer`), read by ``Dataset.streams`` (:mod:`.stream_reader`);
 * :mod:`.reader` and :mod:`.crossview_reader`: :class:`Dataset`, typed access to everything;
 * :mod:`.verify`: re-hash a folder against its manifest.
 
@@ -19,6 +21,8 @@ from scenegen.dataset.journal import load_current_manifest
 from scenegen.dataset.layout import CAMERAS, MANIFEST, mesh_path, view_paths
 from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION
 from scenegen.dataset.reader import Dataset
+from scenegen.dataset.stream_writer import StreamWriter
+from scenegen.dataset.streams import StreamField, StreamSchema
 from scenegen.dataset.truth import TRUTH_KEYS, check_truth
 from scenegen.dataset.verify import VerifyReport, verify
 from scenegen.dataset.view_files import encode_view, software_versions, write_view_files
@@ -28,4 +32,5 @@ __all__ = [
     "CAMERAS", "MANIFEST", "FORMAT", "FORMAT_VERSION", "TRUTH_KEYS", "DatasetError", "DatasetMismatchError",
     "ViewCamera", "view_paths", "mesh_path", "check_truth", "encode_view", "write_view_files",
     "software_versions", "DatasetWriter", "Dataset", "VerifyReport", "verify", "load_current_manifest",
+    "StreamField", "StreamSchema", "StreamWriter",
 ]

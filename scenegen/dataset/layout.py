@@ -30,6 +30,9 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     sequence/stereo_motion/<a>/<b>.exr      a stereo rig's rectified left a -> b: flow, depth and disparity
                                             at b, states in b's rectified left and right views
     sequence/tracks/<stream>.npz            TAP-Vid-style point tracks of a camera stream
+    streams/<name>/stream.json              a sensor stream beside the views (streams.py): kind, sensor,
+                                            schema, chunks with their sample counts and time ranges
+    streams/<name>/chunk_<k>.npz            the samples of chunk k: time_s and one array per field
 
 Every name that becomes part of a path is checked here (:func:`check_name`): names read from a
 spec or from a dataset's own JSON never reach the file system unchecked.
@@ -238,3 +241,19 @@ def stereo_motion_path(a: str, b: str) -> str:
 def tracks_path(stream: str) -> str:
     """Point tracks of a camera stream (view set prefix, with the rig member), NPZ."""
     return f"{SEQUENCE}/tracks/{check_name('stream', stream)}.npz"
+
+
+# --- streams (samples of sensors beside the views) ---------------------------------------------
+STREAMS = "streams"
+
+
+def stream_doc_path(name: str) -> str:
+    """A stream's description (JSON, written when the stream is complete)."""
+    return f"{STREAMS}/{check_name('stream', name)}/stream.json"
+
+
+def stream_chunk_path(name: str, index: int) -> str:
+    """Chunk ``index`` (0, 1, ...) of a stream's samples (NPZ)."""
+    if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < 1_000_000:
+        raise ValueError(f"stream chunk index must be an int in [0, 999999], got {index!r}")
+    return f"{STREAMS}/{check_name('stream', name)}/chunk_{index:06d}.npz"

@@ -6,6 +6,7 @@
     >>> truth = d.truth(d.views[0])                # depth_z, range, points_world, ..., valid
     >>> d.crossview.correspondence("a", "b")       # dense correspondences with visibility
     >>> d.crossview.stereo("left_0000").disparity("left")
+    >>> d.streams["imu0"].field("gyro_rad_s")       # a sensor's samples beside the views
 
 Needs numpy, OpenCV and OpenEXR (trimesh for meshes); never Mitsuba. File hashes are not
 checked here: :func:`scenegen.dataset.verify.verify` does that. A missing view raises KeyError, a
@@ -42,6 +43,7 @@ from scenegen.dataset.journal import load_current_manifest
 from scenegen.dataset.manifest import STATUS_COMPLETE
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.sequence_reader import SequenceTruth
+from scenegen.dataset.stream_reader import Streams
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
@@ -279,6 +281,12 @@ class Dataset:
     def sequence(self) -> SequenceTruth:
         """The truth across time of a sequence (docs/crossview.md, "Sequences")."""
         return SequenceTruth(self)
+
+    # --- streams beside the views
+    @property
+    def streams(self) -> Streams:
+        """The sensors' streams (IMU samples, LiDAR beams, ...; docs/dataset_format.md, "Streams")."""
+        return Streams(self)
 
 
 def _check_names(source: str, *, views=(), paths=(), names=()) -> None:

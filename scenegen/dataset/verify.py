@@ -12,8 +12,9 @@ from scenegen.dataset.codecs.json import read_json
 from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.files import sha256_file
 from scenegen.dataset.journal import apply_record, pending_records, read_journal
-from scenegen.dataset.layout import CAMERAS, MANIFEST, MANIFEST_JOURNAL, check_rel_path, view_paths
+from scenegen.dataset.layout import CAMERAS, MANIFEST, MANIFEST_JOURNAL, STREAMS, check_rel_path, view_paths
 from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION, STATUS_COMPLETE, manifest_integrity_error
+from scenegen.dataset.streams import check_stream_document
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -93,6 +94,7 @@ def verify(out_dir) -> VerifyReport:
             unlisted += [r for r in e.get("files", []) if r not in m["files"]]
             if unlisted:
                 problems.append(f"view {v!r} is complete but has no hash for {unlisted}")
+    problems += _stream_problems(root, m["files"], set(missing + corrupted))
     if CAMERAS in m["files"] and CAMERAS not in missing + corrupted:
         try:
             declared = read_json(root / CAMERAS)["view_order"]
@@ -103,6 +105,31 @@ def verify(out_dir) -> VerifyReport:
             if undeclared:
                 problems.append(f"views in {CAMERAS} but not in {MANIFEST}: {undeclared}")
     return _report(missing, corrupted, unexpected, incomplete, problems, checked=len(m["files"]))
+
+
+def _stream_problems(root: Path, files, bad: set) -> list[str]:
+    """Streams: each document checked (:func:`check_stream_document`) and its chunks listed; chunks
+    of a stream without a document are an unfinished stream."""
+    problems, documented = [], set()
+    for rel in sorted(files):
+        parts = rel.split("/")
+        if len(parts) != 3 or parts[0] != STREAMS or parts[2] != "stream.json" or rel in bad:
+            continue
+        try:
+            doc = read_json(root / rel)
+            check_stream_document(doc, parts[1])
+        except (ValueError, OSError) as e:
+            problems.append(f"{rel}: {e}")
+            continue
+        documented.add(parts[1])
+        unlisted = [c["path"] for c in doc["chunks"] if c["path"] not in files]
+        if unlisted:
+            problems.append(f"{rel}: chunks not listed in {MANIFEST}: {unlisted}")
+    orphans = sorted({r.split("/")[1] for r in files if r.startswith(f"{STREAMS}/") and r.count("/") == 2}
+                     - documented)
+    if orphans:
+        problems.append(f"streams with chunks but no stream.json (unfinished): {orphans}")
+    return problems
 
 
 def _with_journal(root: Path, m: dict) -> tuple[dict, list[str]]:

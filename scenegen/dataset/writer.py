@@ -147,6 +147,10 @@ class DatasetWriter:
         e = self._views.get(view)
         return e is not None and e["status"] == STATUS_COMPLETE
 
+    def file_sha256(self, rel_path: str) -> str | None:
+        """The recorded sha256 of a dataset-level file, or None if it is not recorded."""
+        return self._files.get(rel_path)
+
     @property
     def completed_views(self) -> tuple[str, ...]:
         return tuple(sorted(v for v in self._views if self.is_complete(v)))

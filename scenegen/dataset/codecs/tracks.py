@@ -19,16 +19,14 @@ time), so identical tracks give identical bytes.
 """
 from __future__ import annotations
 
-import io
-import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
+from scenegen.dataset.codecs.npz import decode_npz, encode_npz
 from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 TRACK_KEYS = ("query_points", "tracks_xy", "occluded", "out_of_frame", "image_size", "frame_names")
-_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,34 +63,22 @@ class TrackSet:
         return len(self.query_points)
 
 
-def encode_npz(arrays) -> bytes:
-    """NPZ bytes (stored, not compressed, no pickles, fixed member timestamps) of a mapping
-    name -> array, in its order: what ``np.load(..., allow_pickle=False)`` reads."""
-    buf = io.BytesIO()
-    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as z:
-        for key, arr in arrays.items():
-            member = io.BytesIO()
-            np.lib.format.write_array(member, np.asarray(arr), allow_pickle=False)
-            z.writestr(zipfile.ZipInfo(f"{key}.npy", date_time=_ZIP_TIME), member.getvalue())
-    return buf.getvalue()
-
-
 def encode_tracks(tracks: TrackSet) -> bytes:
     """NPZ bytes (:func:`encode_npz`) of the six arrays of :data:`TRACK_KEYS`."""
     return encode_npz({key: getattr(tracks, key) for key in TRACK_KEYS})
 
 
 def decode_tracks(data: bytes) -> TrackSet:
-    """Inverse of :func:`encode_tracks`; ValueError naming a missing key or a wrong shape."""
+    """Inverse of :func:`encode_tracks`; ValueError naming a missing key, a wrong shape or a
+    member that declares more than it holds (:func:`scenegen.dataset.codecs.npz.decode_npz`)."""
     try:
-        with np.load(io.BytesIO(bytes(data)), allow_pickle=False) as z:
-            missing = [k for k in TRACK_KEYS if k not in z.files]
-            if missing:
-                raise ValueError(f"tracks: keys {missing} missing; have {sorted(z.files)}")
-            arrays = {k: z[k] for k in TRACK_KEYS}
-    except (zipfile.BadZipFile, OSError) as e:
-        raise ValueError(f"tracks: not an NPZ archive ({e})") from None
-    return TrackSet(**arrays)
+        z = decode_npz(data)
+    except ValueError as e:
+        raise ValueError(f"tracks: {e}") from None
+    missing = [k for k in TRACK_KEYS if k not in z]
+    if missing:
+        raise ValueError(f"tracks: keys {missing} missing; have {sorted(z)}")
+    return TrackSet(**{k: z[k] for k in TRACK_KEYS})
 
 
 def write_tracks(path, tracks: TrackSet) -> None:

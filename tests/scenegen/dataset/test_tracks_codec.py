@@ -6,7 +6,9 @@ import zipfile
 import numpy as np
 import pytest
 
-from scenegen.dataset.codecs import TRACK_KEYS, TrackSet, decode_tracks, encode_tracks, read_tracks, write_tracks
+from scenegen.dataset.codecs import (
+    TRACK_KEYS, TrackSet, decode_tracks, encode_npy, encode_tracks, read_tracks, write_tracks,
+)
 from scenegen.dataset.layout import tracks_path
 
 
@@ -45,6 +47,11 @@ def test_bad_input_is_refused_with_the_key_named(tmp_path):
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
         z.writestr("query_points.npy", b"")
+    with pytest.raises(ValueError, match="tracks: member 'query_points'"):  # empty: not an array
+        decode_tracks(buf.getvalue())
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        z.writestr("query_points.npy", encode_npy(np.zeros((2, 3), np.float32)))
     with pytest.raises(ValueError, match="missing"):
         decode_tracks(buf.getvalue())
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
