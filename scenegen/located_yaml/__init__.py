@@ -8,7 +8,6 @@ rejects unknown keys (with a difflib suggestion) and hands out required / option
 """
 from __future__ import annotations
 
-import difflib
 import math
 import re
 from pathlib import Path
@@ -18,23 +17,13 @@ import yaml
 
 from scenegen.errors import SpecError, Where
 from scenegen.located_yaml.compose import compose
-from scenegen.located_yaml.text import non_finite_text, number_text, source_text
+from scenegen.located_yaml.text import non_finite_text, number_text, out_of_range_text, quoted_list, source_text, suggest
 
 _NUMBER_RE = re.compile(r"^[-+]?(\d[\d_]*\.?[\d_]*|\.\d[\d_]*)([eE][-+]?\d+)?$")
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
 #: Longest name (scene, object, camera, ...): names become file names; equal to
 #: scenegen.dataset.layout.MAX_NAME_LEN (tests/hostile/test_hostile_limits.py checks).
 MAX_NAME_LEN = 128
-
-
-def suggest(word: str, choices: Iterable[str]) -> str:
-    """' (did you mean 'x'?)' for the closest choice, or ''."""
-    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
-def quoted_list(choices: Iterable) -> str:
-    return ", ".join(repr(c) for c in choices)
 
 
 class Document:
@@ -294,15 +283,9 @@ class Node:
 
 
 def _check_range(node: Node, v, lo, hi, lo_open, hi_open, u):
-    bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
-    bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
-    if bad_lo or bad_hi:
-        parts = []
-        if lo is not None:
-            parts.append(f"{'>' if lo_open else '>='} {number_text(lo)}")
-        if hi is not None:
-            parts.append(f"{'<' if hi_open else '<='} {number_text(hi)}")
-        raise node.error(f"expected a value {' and '.join(parts)}{u}, got {number_text(v)}")
+    problem = out_of_range_text(v, lo, hi, lo_open, hi_open, u)
+    if problem:
+        raise node.error(problem)
 
 
 class Fields:
