@@ -22,8 +22,10 @@ class Rigid3:
     t: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self):
-        R = as_rotation(self.R)
-        t = np.asarray(self.t, dtype=np.float64).reshape(-1)
+        # C order always: numpy's matmul takes other kernels (other rounding, with FMA on some
+        # CPUs) for other memory layouts, and a pose must give the same bits however it was made
+        R = np.ascontiguousarray(as_rotation(self.R))
+        t = np.ascontiguousarray(self.t, dtype=np.float64).reshape(-1)
         if t.shape != (3,) or not np.all(np.isfinite(t)):
             raise ValueError(f"translation must be 3 finite numbers, got {self.t!r}")
         R.setflags(write=False)
@@ -63,7 +65,7 @@ class Rigid3:
         checked again (the check was 80 % of composing two poses; per-row poses compose
         thousands per frame)."""
         out = object.__new__(cls)
-        R, t = np.array(R, np.float64), np.array(t, np.float64)
+        R, t = np.array(R, np.float64, order="C"), np.array(t, np.float64, order="C")  # as __post_init__
         R.setflags(write=False)
         t.setflags(write=False)
         object.__setattr__(out, "R", R)
