@@ -16,6 +16,8 @@ import secrets
 from pathlib import Path
 from typing import BinaryIO, Callable
 
+from scenegen.dataset.layout import check_rel_path
+
 #: Suffix of the temporary files made by :func:`atomic_write` (``.<name>.<random>.scenegen-tmp``).
 TEMP_SUFFIX = ".scenegen-tmp"
 
@@ -159,3 +161,19 @@ def read_decoded(path, decode):
         return decode(Path(path).read_bytes())
     except ValueError as e:
         raise ValueError(f"{path}: {e}") from None
+
+
+class FileSink:
+    """Dataset-level files written atomically under ``root`` by a process that does not own the
+    dataset's writer (a Dask worker): ``files`` keeps ``{relative path: sha256}`` for the owner to
+    record (:meth:`scenegen.dataset.writer.DatasetWriter.record_files`)."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+        self.files: dict[str, str] = {}
+
+    def write_file(self, rel_path: str, data: bytes) -> str:
+        sha = sha256_bytes(data)
+        atomic_write_bytes(self.root / check_rel_path(rel_path), data)
+        self.files[rel_path] = sha
+        return sha

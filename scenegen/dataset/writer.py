@@ -199,6 +199,26 @@ class DatasetWriter:
             self._log([file_record(rel_path, sha)])
         return sha
 
+    def record_files(self, file_hashes: Mapping[str, str]) -> None:
+        """Record dataset-level files already written (atomically, by
+        :class:`scenegen.dataset.files.FileSink` in a worker): ``{relative path: sha256}``, with
+        one fsync'd journal batch; a file recorded before with other content raises
+        :class:`DatasetMismatchError` before anything is recorded."""
+        new = {}
+        for rel, sha in file_hashes.items():
+            check_rel_path(rel)
+            if not (isinstance(sha, str) and re.fullmatch(r"[0-9a-f]{64}", sha)):
+                raise ValueError(f"{rel}: sha256 must be 64 lower-case hex digits, got {sha!r}")
+            old = self._files.get(rel)
+            if old is not None and old != sha:
+                raise DatasetMismatchError(f"{rel} is already recorded in {self.root} with different content"
+                                           f" (sha256 {old[:12]}... != {sha[:12]}...): outputs are not deterministic")
+            if old is None:
+                new[rel] = sha
+        self._files.update(new)
+        if new:
+            self._log([file_record(rel, sha) for rel, sha in new.items()])
+
     def write_view(self, view: str, *, image, linear_rgb, truth,
                    extra_files: Mapping[str, bytes] | None = None) -> None:
         """Encode, write and hash one view's files, then mark it complete in the manifest.

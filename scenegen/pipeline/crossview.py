@@ -46,7 +46,6 @@ from scenegen.dataset.layout import (
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
-from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.stereo import write_stereo_frame
 from scenegen.pipeline.view import correspond_fn, rolling_rows, view_truth, visibility_fn
 
@@ -63,18 +62,19 @@ class CrossviewSummary:
     files: int
 
 
-class _Context:
-    """What the stage's writers share: the complete views, the loaded scene, cached truth points
-    and correspondences, and the files written."""
+class CrossviewContext:
+    """What the stage's items share where they run (the driver, or a Dask worker): the complete
+    views, the loaded scene, the render settings, cached truth points and correspondences, and
+    ``sink`` (``root``, ``write_file(rel, data)``) that writes the files."""
 
-    def __init__(self, spec, views, built, writer):
-        self.spec, self.built, self.writer = spec, built, writer
+    def __init__(self, spec, views, built, sink, *, spp: int, seed: int):
+        self.spec, self.built, self.sink = spec, built, sink
+        self.spp, self.seed = spp, seed
         self.views = {v.name: v for v in views}
         self._points: dict = {}
         self._ids: dict = {}
         self._corr: dict = {}
         self._geometry: dict = {}
-        self.files: list[str] = []
 
     def camera(self, name):
         v = self.views[name]
@@ -121,11 +121,10 @@ class _Context:
         return self._corr[(i, j)]
 
     def write(self, rel: str, data: bytes) -> None:
-        self.writer.write_file(rel, data)
-        self.files.append(rel)
+        self.sink.write_file(rel, data)
 
 
-def _homographies(ctx: _Context, i: str, j: str) -> dict:
+def _homographies(ctx: CrossviewContext, i: str, j: str) -> dict:
     """Plane homographies (undistorted pixels i -> j) of every planar object: planes and boards."""
     cam_i, pose_i = ctx.camera(i)
     cam_j, pose_j = ctx.camera(j)
@@ -143,7 +142,7 @@ def _homographies(ctx: _Context, i: str, j: str) -> dict:
     return out
 
 
-def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
+def _pair(ctx: CrossviewContext, cfg, a: str, b: str) -> dict:
     """Correspondences both ways, two-view geometry and match sets of one pair; its index entry."""
     entry = {"i": a, "j": b}
     for i, j in ((a, b), (b, a)):
@@ -163,7 +162,7 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
         ctx.write(matches_path(a, b, "synthetic"), encode_npy(rows))
         entry["synthetic_matches"] = {"count": len(rows), "seed": p.seed}
     if cfg.sift:
-        root = ctx.writer.root
+        root = ctx.sink.root
         pi, pj = sift_matches(read_png(root / view_paths(a)["image"]), read_png(root / view_paths(b)["image"]),
                               cfg.sift_ratio)
         ctx.at(a)
@@ -185,59 +184,82 @@ def _pair(ctx: _Context, cfg, a: str, b: str) -> dict:
     return entry
 
 
-def run_crossview(spec, views, built, writer, *, spp: int, seed: int,
-                  progress: bool = False) -> CrossviewSummary | None:
-    """Write the cross-view truth ``spec.crossview`` asks for (nothing when it is None).
+@dataclass(frozen=True)
+class CrossviewPlan:
+    """The stage's items, in the order their index entries are listed: ``("pair", a, b)``,
+    ``("flow", i, j)``, ``("stereo", left, right)``, ``("targets", view, None)``; ``done``: the
+    complete views; ``whole``: every view is complete (the index is written)."""
 
-    ``views``: the resolved views; ``built``: the loaded scene (:class:`scenegen.render.scene.LoadedScene`);
-    ``writer``: the open DatasetWriter; ``spp``, ``seed``: render settings (rectified renders);
-    ``progress``: a bar on stderr counting the stage's items (view pairs, flow pairs, stereo
-    frames, views with board truth).
-    """
+    items: tuple[tuple, ...]
+    done: tuple[str, ...]
+    whole: bool
+
+
+def plan_crossview(spec, views, is_complete, has_boards: bool) -> CrossviewPlan | None:
+    """The items of the cross-view truth ``spec.crossview`` asks for (None when it is None), for
+    the views ``is_complete(name)`` says are written (a ``--frames`` run covers what it has);
+    ``has_boards``: the scene has calibration boards (per-view board truth)."""
     cfg = getattr(spec, "crossview", None)
     if cfg is None:
         return None
-    done = [v for v in views if writer.is_complete(v.name)]
-    ctx = _Context(spec, done, built, writer)
-    names = set(ctx.views)
-    pairs = [p for p in select_pairs(cfg.pairs, views) if p[0] in names and p[1] in names]
-    flows = [(va, vb) for vs in streams(views).values() for va, vb in zip(vs, vs[1:])
-             if va.name in names and vb.name in names] if cfg.flow else []  # adjacent frames of the
-    # full stream, both complete: stable across --frames runs
-    stereo = list(stereo_frames(done, spec.rigs)) if cfg.stereo else []
-    targets = done if cfg.targets and built.boards else []
+    done = [v for v in views if is_complete(v.name)]
+    names = {v.name for v in done}
+    items = [("pair", a, b) for a, b in select_pairs(cfg.pairs, views) if a in names and b in names]
+    if cfg.flow:  # adjacent frames of the full stream, both complete: stable across --frames runs
+        items += [("flow", va.name, vb.name) for vs in streams(views).values() for va, vb in zip(vs, vs[1:])
+                  if va.name in names and vb.name in names]
+    if cfg.stereo:
+        items += [("stereo", left, right) for left, right in stereo_frames(done, spec.rigs)]
+    if cfg.targets and has_boards:
+        items += [("targets", v.name, None) for v in done]
+    return CrossviewPlan(tuple(items), tuple(v.name for v in done), len(done) == len(views))
+
+
+def execute_crossview_item(ctx: CrossviewContext, item: tuple):
+    """Write one item's files through ``ctx``; returns its index entry."""
+    kind, a, b = item
+    if kind == "pair":
+        return _pair(ctx, ctx.spec.crossview, a, b)
+    if kind == "flow":
+        for i, j in ((a, b), (b, a)):
+            ctx.write(flow_path(i, j), encode_flo(flow_field(ctx.corr(i, j))))
+        return {"i": a, "j": b}
+    if kind == "stereo":
+        return write_stereo_frame(ctx, a, b, spp=ctx.spp, seed=ctx.seed)
+    if kind == "targets":
+        return _board_views(ctx, a)
+    raise ValueError(f"unknown cross-view item {item!r}")
+
+
+def _board_views(ctx: CrossviewContext, name: str) -> str:
+    """Every calibration board's truth in one view (a moving board moved with its object)."""
+    cam, pose = ctx.camera(name)
+    ctx.at(name)
+    objects = {o.name: o for o in ctx.spec.objects}
+    boards = {}
+    for bname, (board, wfb) in ctx.built.boards.items():
+        obj = objects[bname]
+        wfb_v = ctx.object_pose(obj, name) @ obj.transform.world_from_object.inverse() @ wfb
+        boards[bname] = board_view_truth(board, wfb_v, cam, pose, ctx.built.visible_from, ctx.geometry(name),
+                                         (obj.object_id, ctx.object_pose(obj, name)))
+    ctx.write(view_targets_path(name), encode_json({"view": name, "boards": boards}))
+    return name
+
+
+_INDEX_KEYS = {"pair": "pairs", "flow": "flow", "stereo": "stereo", "targets": "targets"}
+
+
+def finish_crossview(plan: CrossviewPlan, entries, files, writer) -> CrossviewSummary:
+    """Write the index (every view complete) of the items' ``entries`` (in the plan's order) and
+    the ``files`` they wrote."""
     index = {"format": INDEX_FORMAT, "format_version": INDEX_FORMAT_VERSION,
              "occlusion_rel_tol": OCCLUSION_REL_TOL,
              "state_codes": {str(k): v for k, v in STATE_NAMES.items()},
              "match_columns": list(MATCH_COLUMNS), "match_labels": {str(k): v for k, v in LABELS.items()},
              "pairs": [], "flow": [], "stereo": [], "targets": []}
-    total = len(pairs) + len(flows) + len(stereo) + len(targets)
-    with ViewProgress(progress, total, label="cross-view truth", unit="items") as bar:
-        for a, b in pairs:
-            index["pairs"].append(_pair(ctx, cfg, a, b))
-            bar.advance()
-        for va, vb in flows:
-            for i, j in ((va.name, vb.name), (vb.name, va.name)):
-                ctx.write(flow_path(i, j), encode_flo(flow_field(ctx.corr(i, j))))
-            index["flow"].append({"i": va.name, "j": vb.name})
-            bar.advance()
-        for left, right in stereo:
-            index["stereo"].append(write_stereo_frame(ctx, left, right, spp=spp, seed=seed))
-            bar.advance()
-        objects = {o.name: o for o in spec.objects}
-        for v in targets:
-            cam, pose = ctx.camera(v.name)
-            ctx.at(v.name)
-            boards = {}
-            for name, (board, wfb) in built.boards.items():  # a moving board: moved with its object
-                obj = objects[name]
-                wfb_v = ctx.object_pose(obj, v.name) @ obj.transform.world_from_object.inverse() @ wfb
-                boards[name] = board_view_truth(board, wfb_v, cam, pose, built.visible_from, ctx.geometry(v.name),
-                                                (obj.object_id, ctx.object_pose(obj, v.name)))
-            ctx.write(view_targets_path(v.name), encode_json({"view": v.name, "boards": boards}))
-            index["targets"].append(v.name)
-            bar.advance()
-    index["files"] = sorted(ctx.files)
-    if len(done) == len(views):  # the index describes the whole run; partial runs write none
+    for (kind, _, _), entry in zip(plan.items, entries):
+        index[_INDEX_KEYS[kind]].append(entry)
+    index["files"] = sorted(files)
+    if plan.whole:  # the index describes the whole run; partial runs write none
         writer.write_file(CROSSVIEW_INDEX, encode_json(index))
-    return CrossviewSummary(len(index["pairs"]), len(index["flow"]), len(index["stereo"]), len(ctx.files) + 1)
+    return CrossviewSummary(len(index["pairs"]), len(index["flow"]), len(index["stereo"]), len(files) + 1)

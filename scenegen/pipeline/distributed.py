@@ -28,12 +28,13 @@ from scenegen.pipeline.view import render_view_data
 from scenegen.render import configure_llvm, load_scene
 from scenegen.spec import resolve_views
 
-__all__ = ["open_client", "render_views_dask", "render_frame_task", "worker_stats", "SCENES_KEPT"]
+__all__ = ["open_client", "render_views_dask", "render_frame_task", "worker_scene", "worker_stats", "note_stage_items",
+           "SCENES_KEPT"]
 
 #: Loaded scenes a worker keeps (least recently used dropped first).
 SCENES_KEPT = 2
 _SCENES: "OrderedDict[tuple, tuple]" = OrderedDict()  # key -> (spec, views, built)
-_STATS = {"scene_loads": 0, "views_rendered": 0}
+_STATS = {"scene_loads": 0, "views_rendered": 0, "stage_items": 0}
 
 
 @contextlib.contextmanager
@@ -71,7 +72,7 @@ def open_client(*, workers: int | None = None, scheduler: str | None = None):
         cluster.close()
 
 
-def _worker_scene(source, spp: int, variant: str):
+def worker_scene(source, spp: int, variant: str):
     """(spec, views, built) for ``source``, loaded once per worker and kept."""
     key = (source.key, int(spp), variant)
     hit = _SCENES.get(key)
@@ -90,7 +91,7 @@ def _worker_scene(source, spp: int, variant: str):
 def render_frame_task(source, out_dir: str, items, spp: int, seed: int, variant: str):
     """Worker task: render and write the views ``items`` = [(index in the run, view name)];
     returns [(view name, {relative path: sha256})]."""
-    spec, views, built = _worker_scene(source, spp, variant)
+    spec, views, built = worker_scene(source, spp, variant)
     out = []
     for index, name in items:
         v = views[index]
@@ -104,8 +105,14 @@ def render_frame_task(source, out_dir: str, items, spp: int, seed: int, variant:
     return out
 
 
+def note_stage_items(n: int) -> None:
+    """Count ``n`` stage items run in this process (:mod:`scenegen.pipeline.stages`)."""
+    _STATS["stage_items"] += int(n)
+
+
 def worker_stats() -> dict:
-    """This process's counters: scene_loads, views_rendered, pid (run it with ``client.run``)."""
+    """This process's counters: scene_loads, views_rendered, stage_items, pid (run it with
+    ``client.run``)."""
     return {**_STATS, "pid": os.getpid()}
 
 

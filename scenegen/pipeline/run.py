@@ -17,10 +17,9 @@ from scenegen.dataset.targets import target_document
 from scenegen.dataset.view_files import software_versions
 from scenegen.dataset.writer import DatasetWriter
 from scenegen.imaging.stage import imaging_record, raw_view_record
-from scenegen.pipeline.crossview import run_crossview
 from scenegen.pipeline.distributed import render_views_dask
 from scenegen.pipeline.progress import ViewProgress
-from scenegen.pipeline.sequence import run_sequence
+from scenegen.pipeline.stages import run_stage
 from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
@@ -124,6 +123,8 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
     targets, the views, the cross-view and sequence stages; then the manifest is compacted.
     Returns (views rendered, views selected, views already complete)."""
     spp, seed = used.spp, used.seed
+    if dask_client is not None:  # what a worker loads: the spec's text, shipped with each task
+        source = source if isinstance(source, SpecSource) else SpecSource.from_path(source)
     view_cams = {v.name: ViewCamera(camera=built.cameras[v.camera], cam_from_world=v.cam_from_world,
                                        camera_name=v.camera, rig=v.rig, rig_member=v.rig_member,
                                        frame_index=v.frame_index, optics=view_optics(built, v),
@@ -151,7 +152,6 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
         for _ in range(skipped):
             bar.advance()
         if dask_client is not None:  # workers render and write; recorded here in the run's order
-            source = source if isinstance(source, SpecSource) else SpecSource.from_path(source)
             rendered = render_views_dask(dask_client, source, writer, pending, spp=spp, seed=seed,
                                          variant=used.variant, on_done=bar.advance)
         else:  # a view is encoded and written on a thread while the next one renders
@@ -162,7 +162,8 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
                     del image, linear, truth, extra  # the writer holds the only references
                     rendered += 1
                     bar.advance()
-    run_crossview(spec, views, built, writer, spp=spp, seed=seed, progress=progress)  # docs/crossview.md
-    run_sequence(spec, views, built, writer)  # truth across time of a sequence (docs/crossview.md)
+    for stage in ("crossview", "sequence"):  # cross-view truth, then truth across time (docs/crossview.md)
+        run_stage(stage, spec, views, built, writer, spp=spp, seed=seed, variant=used.variant, client=dask_client,
+                  source=source, progress=progress)
     writer.close()
     return rendered, todo, skipped

@@ -12,6 +12,7 @@ written when every view is complete.
 from __future__ import annotations
 
 from collections import OrderedDict
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -129,27 +130,30 @@ def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
                     image_size=np.array([cam.width, cam.height]), frame_names=np.array([v.name for v in vs]))
 
 
-def run_sequence(spec, views, built, writer) -> dict | None:
-    """Write the sequence truth of ``spec.sequence`` (nothing for a static spec); the index."""
+@dataclass(frozen=True)
+class SequencePlan:
+    """The stage's items in the order they run best (each target frame's scene moved once):
+    ``("motion", a, b)`` (view names: motion truth a -> b and its .flo), ``("tracks", stream,
+    frames)``, ``("stereo_motion", (left a, right a), (left b, right b))`` (both ways); ``index``:
+    the index without its file list; ``whole``: every view is complete (the index is written)."""
+
+    items: tuple[tuple, ...]
+    index: dict
+    whole: bool
+    keep_frames: int
+
+
+def plan_sequence(spec, views, is_complete) -> SequencePlan | None:
+    """The items of the sequence truth of ``spec.sequence`` (None for a static spec), for the
+    views ``is_complete(name)`` says are written."""
     seq = getattr(spec, "sequence", None)
     if seq is None:
         return None
-    # frames a step away on both sides stay cached while the targets are walked in order
-    st = SequenceTruth(spec, built, keep_frames=2 * max(seq.flow_steps) + 2)
-    done = [v for v in views if writer.is_complete(v.name)]
-    names = {v.name for v in done}
-    files: list[str] = []
-
-    def write(rel, data):
-        writer.write_file(rel, data)
-        files.append(rel)
-
-    frames = [(k, t, {o.name: (o.object_id, s) for o, s in zip(spec.objects, st.timeline.states(t).values())})
-              for k, t in enumerate(seq.timestamps_s)]
-    write(SEQUENCE_OBJECTS, encode_json(objects_document(frames)))
+    names = {v.name for v in views if is_complete(v.name)}
     index = {"format": SEQUENCE_FORMAT, "format_version": SEQUENCE_FORMAT_VERSION,
              "timestamps_s": list(seq.timestamps_s), "scene_flow_frame": SCENE_FLOW_FRAME,
              "state_codes": {str(k): v for k, v in STATE_NAMES.items()}, "pairs": [], "tracks": []}
+    items = []
     for (set_index, member), vs in streams(views).items():
         name = stream_name(spec.view_sets[set_index].prefix, member)
         jobs = []  # (position of the target frame, source, target): one scene move per target
@@ -159,23 +163,68 @@ def run_sequence(spec, views, built, writer) -> dict | None:
                     continue
                 jobs += [(k + step, a, b), (k, b, a)]
                 index["pairs"].append({"a": a.name, "b": b.name, "step": step})
-        for _, i, j in sorted(jobs, key=lambda job: job[0]):
-            m = st.motion(i, j)
-            write(motion_path(i.name, j.name), encode_exr(encode_motion_channels(m)))
-            write(sequence_flow_path(i.name, j.name), encode_flo(m.flow))
+        items += [("motion", i.name, j.name) for _, i, j in sorted(jobs, key=lambda job: job[0])]
         if seq.tracks is not None and all(v.name in names for v in vs):
-            write(tracks_path(name), encode_tracks(stream_tracks(st, vs, name, seq.tracks)))
+            items.append(("tracks", name, tuple(v.name for v in vs)))
             index["tracks"].append({"stream": name, "frames": [v.name for v in vs]})
     jobs = stereo_pairs(spec, views, names, seq.flow_steps)
     if jobs:  # only then the key: sequences without rectified stereo keep their index bytes
-        ss = StereoSequence(st, keep_frames=2 * max(seq.flow_steps) + 2)
-        index["stereo_pairs"] = []
-        for step, fa, fb in jobs:
-            for i, j in ((fa, fb), (fb, fa)):
-                m = encode_stereo_motion_channels(ss.motion(i, j))
-                write(stereo_motion_path(i[0].name, j[0].name), encode_exr(m))
-            index["stereo_pairs"].append({"a": fa[0].name, "b": fb[0].name, "step": step})
-    index["files"] = sorted(files)
-    if len(done) == len(views):
+        index["stereo_pairs"] = [{"a": fa[0].name, "b": fb[0].name, "step": step} for step, fa, fb in jobs]
+        items += [("stereo_motion", tuple(v.name for v in fa), tuple(v.name for v in fb)) for _, fa, fb in jobs]
+    return SequencePlan(tuple(items), index, len(names) == len(views), 2 * max(seq.flow_steps) + 2)
+
+
+class SequenceContext:
+    """What the sequence items share where they run: the views by name, the frames' truth (the
+    last ``keep_frames`` frames cached) and ``sink`` (``write_file(rel, data)``)."""
+
+    def __init__(self, spec, views, built, sink, *, keep_frames: int):
+        self.spec, self.sink = spec, sink
+        self.views = {v.name: v for v in views}
+        # frames a step away on both sides stay cached while the targets are walked in order
+        self.st = SequenceTruth(spec, built, keep_frames=keep_frames)
+        self._stereo = None
+        self.keep_frames = keep_frames
+
+    @property
+    def stereo(self) -> StereoSequence:
+        if self._stereo is None:
+            self._stereo = StereoSequence(self.st, keep_frames=self.keep_frames)
+        return self._stereo
+
+
+def execute_sequence_item(ctx: SequenceContext, item: tuple) -> None:
+    """Write one item's files through ``ctx``."""
+    kind, a, b = item
+    if kind == "motion":
+        m = ctx.st.motion(ctx.views[a], ctx.views[b])
+        ctx.sink.write_file(motion_path(a, b), encode_exr(encode_motion_channels(m)))
+        ctx.sink.write_file(sequence_flow_path(a, b), encode_flo(m.flow))
+    elif kind == "tracks":
+        vs = [ctx.views[n] for n in b]
+        ctx.sink.write_file(tracks_path(a), encode_tracks(stream_tracks(ctx.st, vs, a, ctx.spec.sequence.tracks)))
+    elif kind == "stereo_motion":
+        fa, fb = tuple(ctx.views[n] for n in a), tuple(ctx.views[n] for n in b)
+        for i, j in ((fa, fb), (fb, fa)):
+            m = encode_stereo_motion_channels(ctx.stereo.motion(i, j))
+            ctx.sink.write_file(stereo_motion_path(i[0].name, j[0].name), encode_exr(m))
+    else:
+        raise ValueError(f"unknown sequence item {item!r}")
+
+
+def write_objects_document(spec, writer) -> str:
+    """sequence/objects.json: every object's pose, presence and velocities per frame (the driver
+    writes it before the items; no casting)."""
+    timeline = Timeline(spec)
+    frames = [(k, t, {o.name: (o.object_id, s) for o, s in zip(spec.objects, timeline.states(t).values())})
+              for k, t in enumerate(spec.sequence.timestamps_s)]
+    writer.write_file(SEQUENCE_OBJECTS, encode_json(objects_document(frames)))
+    return SEQUENCE_OBJECTS
+
+
+def finish_sequence(plan: SequencePlan, files, writer) -> dict:
+    """Write the index (every view complete) with the ``files`` the stage wrote; returns it."""
+    index = {**plan.index, "files": sorted(files)}
+    if plan.whole:
         writer.write_file(SEQUENCE_INDEX, encode_json(index))
     return index
