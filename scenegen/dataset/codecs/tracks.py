@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scenegen.dataset.codecs.npy import decode_npz
 from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 TRACK_KEYS = ("query_points", "tracks_xy", "occluded", "out_of_frame", "image_size", "frame_names")
@@ -83,16 +84,13 @@ def encode_tracks(tracks: TrackSet) -> bytes:
 
 
 def decode_tracks(data: bytes) -> TrackSet:
-    """Inverse of :func:`encode_tracks`; ValueError naming a missing key or a wrong shape."""
+    """Inverse of :func:`encode_tracks`; ValueError naming a missing key or a wrong shape (array
+    sizes checked before anything is allocated: :func:`scenegen.dataset.codecs.npy.decode_npz`)."""
     try:
-        with np.load(io.BytesIO(bytes(data)), allow_pickle=False) as z:
-            missing = [k for k in TRACK_KEYS if k not in z.files]
-            if missing:
-                raise ValueError(f"tracks: keys {missing} missing; have {sorted(z.files)}")
-            arrays = {k: z[k] for k in TRACK_KEYS}
-    except (zipfile.BadZipFile, OSError) as e:
-        raise ValueError(f"tracks: not an NPZ archive ({e})") from None
-    return TrackSet(**arrays)
+        arrays = decode_npz(data, required=TRACK_KEYS)
+    except ValueError as e:
+        raise ValueError(f"tracks: {e}") from None
+    return TrackSet(**{k: arrays[k] for k in TRACK_KEYS})
 
 
 def write_tracks(path, tracks: TrackSet) -> None:
