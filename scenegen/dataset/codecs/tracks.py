@@ -59,6 +59,11 @@ class TrackSet:
             if arrays[k].shape != shape or n < 0:
                 raise ValueError(f"tracks: {k} must have shape {shape} (N tracks, T frames), got "
                                  f"{arrays[k].shape}")
+        lost = ~arrays["occluded"] & ~np.all(np.isfinite(arrays["tracks_xy"]), axis=-1)
+        if lost.any():
+            i, t_ = np.argwhere(lost)[0]
+            raise ValueError(f"tracks: tracks_xy[{i}, {t_}] is not finite where the point is visible (expected finite "
+                             f"pixel coordinates wherever occluded is false; {int(lost.sum())} such entries)")
         for k, v in arrays.items():
             object.__setattr__(self, k, v)
 
