@@ -150,7 +150,8 @@ def invoke(options: dict, values: dict, log_dir: Path, item: str, out) -> str | 
     try:  # in its own process group, killed with the command (runners/process_group.py)
         status = run_group(argv, log_dir / "stdout.txt", log_dir / "stderr.txt", timeout)
     except OSError as exc:
-        raise InputError(f"method {options['name']!r}: cannot run {argv[0]!r}: {exc.strerror or exc}") from None
+        where = "" if options.get("declared_at", CLI) == CLI else f"{options['declared_at']}: "  # the methods file
+        raise InputError(f"{where}method {options['name']!r}: cannot run {argv[0]!r}: {exc.strerror or exc}") from None
     why = (f"timed out after {timeout:g} s" if status is None else None if status == 0 else
            f"killed by signal {-status}" if status < 0 else f"exit status {status}")
     if why is not None:
