@@ -243,7 +243,8 @@ FLO_HEAD = np.array([202021.25], "<f4").tobytes() + np.array([4, 3], "<i4").toby
 case("flow_ok", "flow", "f.flo", FLO_HEAD + np.zeros(24, "<f4").tobytes(), "epe", 0)
 case("flow_flo_magic", "flow", "f.flo", b"\x00" * 20,
      "not a .flo file (magic 0, bytes b'\\x00\\x00\\x00\\x00'; expected 202021.25, bytes b'PIEH')")
-case("flow_flo_truncated", "flow", "f.flo", FLO_HEAD + b"\x00" * 8, "expected sizes >= 1 and 12 + 8 * W * H = 108 bytes")
+case("flow_flo_truncated", "flow", "f.flo", FLO_HEAD + b"\x00" * 8,
+     "expected sizes >= 1 and 12 + 8 * W * H = 108 bytes")
 case("flow_flo_short", "flow", "f.flo", b"PIEH", "expected a 12-byte header")
 case("flow_flo_huge_size", "flow", "f.flo", FLO_HEAD[:4] + np.array([2**31 - 1] * 2, "<i4").tobytes(),
      "a .flo header of width 2147483647 and height 2147483647")

@@ -13,7 +13,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hostile_data import run_cli, write_dataset, write_sequence_dataset  # noqa: E402
-from output_corpus import CAL, CASES, FLO_HEAD, GOOD_POSE, GOOD_TRACKS, H_GOOD, TUM_OK, G, npy_bytes, tracks_npz  # noqa: E402
+from output_corpus import (CAL, CASES, FLO_HEAD, GOOD_POSE, GOOD_TRACKS, H_GOOD, TUM_OK, G,  # noqa: E402
+                           npy_bytes, tracks_npz)
 
 from scenegen.dataset.codecs import encode_tracks  # noqa: E402
 

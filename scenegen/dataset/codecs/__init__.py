@@ -41,7 +41,8 @@ __all__ = [
     "decode_flo", "encode_flo", "decode_json", "encode_json", "read_json", "write_json",
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
     "decode_kitti_flow_png", "encode_kitti_flow_png",
-    "decode_npy", "decode_npz", "encode_npy", "read_npy", "read_npz", "write_npy", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
+    "decode_npy", "decode_npz", "encode_npy", "read_npy", "read_npz", "write_npy",
+    "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
     "decode_png", "encode_png", "read_png", "write_png", "decode_cam", "decode_dpt", "encode_cam", "encode_dpt",
     "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_npz", "encode_tracks", "read_tracks", "write_tracks",
 ]

@@ -84,7 +84,8 @@ def test_an_interrupt_kills_the_group(tmp_path, monkeypatch):
 
 
 def test_exit_statuses_and_a_missing_program(tmp_path):
-    assert process_group.run_group([sys.executable, "-c", "raise SystemExit(3)"], tmp_path / "o", tmp_path / "e", 30) == 3
+    o, e = tmp_path / "o", tmp_path / "e"
+    assert process_group.run_group([sys.executable, "-c", "raise SystemExit(3)"], o, e, 30) == 3
     assert process_group.run_group([sys.executable, "-c", "import os; os.kill(os.getpid(), 9)"], tmp_path / "o",
                                    tmp_path / "e", 30) == -9
     with pytest.raises(OSError):
