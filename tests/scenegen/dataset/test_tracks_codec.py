@@ -53,3 +53,14 @@ def test_bad_input_is_refused_with_the_key_named(tmp_path):
     assert tracks_path("cam_left") == "sequence/tracks/cam_left.npz"
     with pytest.raises(ValueError):
         tracks_path("../x")
+
+
+def test_a_visible_point_must_be_finite_occluded_ones_may_be_nan():
+    tr = _tracks()
+    xy = tr.tracks_xy.copy()
+    xy[tr.occluded] = np.nan  # where it does not project: allowed when occluded
+    TrackSet(tr.query_points, xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)
+    i, t = np.argwhere(~tr.occluded)[0]
+    xy[i, t, 1] = np.inf
+    with pytest.raises(ValueError, match=rf"tracks_xy\[{i}, {t}\] is not finite where the point is visible"):
+        TrackSet(tr.query_points, xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)
