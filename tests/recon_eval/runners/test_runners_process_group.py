@@ -3,6 +3,7 @@ on a timeout, on an interrupt, and when the command exits leaving a child behind
 scripts start a sleeping child and record both pids; afterwards no process of the group runs."""
 from __future__ import annotations
 
+import json
 import shlex
 import sys
 import time
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from recon_eval.cli import main
 from recon_eval.runners import external, process_group
 from recon_eval.runners.common import RunOutput
 
@@ -90,3 +92,22 @@ def test_exit_statuses_and_a_missing_program(tmp_path):
                                    tmp_path / "e", 30) == -9
     with pytest.raises(OSError):
         process_group.run_group([str(tmp_path / "no-such-program")], tmp_path / "o", tmp_path / "e", 30)
+
+
+def test_run_command_with_a_hanging_estimator_ends_its_children(tmp_path):
+    """The audit's case end to end: ``recon-eval run --command`` with an estimator that starts a
+    child and hangs, ``--timeout 1``: the run completes, scored as a failure naming the method,
+    and 0 processes of the group are left."""
+    sys.path.insert(0, str(Path(__file__).parents[2] / "scenegen" / "dataset"))
+    from test_dataset import write_dataset  # the hostile tests' small dataset
+
+    write_dataset(tmp_path / "ds")
+    argv = script(tmp_path, "time.sleep(120)\n")
+    command = " ".join(["{python}", *map(shlex.quote, argv[1:]), "{images}", "{out}"])
+    t0 = time.monotonic()
+    code = main(["run", "--command", command, "--kind", "sfm", "--name", "hang", "--timeout", "1",
+                 str(tmp_path / "ds"), "-o", str(tmp_path / "runs"), "--quiet"])
+    assert code == 0 and time.monotonic() - t0 < 30
+    notes = json.loads((tmp_path / "runs" / "result.json").read_text())["inputs"]["notes"]
+    assert notes["sfm"]["failed"] == "timed out after 1 s"
+    assert len(pids(tmp_path)) == 2 and wait_gone(pids(tmp_path)) == []
