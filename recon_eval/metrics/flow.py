@@ -44,6 +44,20 @@ def kitti_interpolate_flow(flow) -> np.ndarray:
     return out
 
 
+def kitti_flow_outliers(flow_ipol, flow_gt, abs_thresh_px: float = 3.0, rel_thresh: float = 0.05) -> np.ndarray:
+    """(H, W) bool ``f_err`` of the devkit's ``flowErrorsOutlier`` (evaluate_scene_flow.cpp) in its
+    float arithmetic: ``f_dist = sqrt(fu*fu + fv*fv)`` of the float differences, ``f_mag`` the
+    truth's (``getFlowMagnitude``), both float32, and the float quotient ``f_dist / f_mag``,
+    compared with the double constants 3.0 and 0.05. Ties are common on the KITTI PNG's 1/64 px
+    grid, and decided there: 5 / 100 in float is 0.0500000007 > 0.05, an outlier (not in float64)."""
+    e, g = np.asarray(flow_ipol, np.float32), np.asarray(flow_gt, np.float32)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        fu, fv = g[..., 0] - e[..., 0], g[..., 1] - e[..., 1]
+        f_dist = np.sqrt(fu * fu + fv * fv)
+        f_mag = np.sqrt(g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1])
+        return (f_dist.astype(np.float64) > abs_thresh_px) & ((f_dist / f_mag).astype(np.float64) > rel_thresh)
+
+
 @dataclass(frozen=True)
 class FlowResult:
     """Flow errors, pooled over the image pairs (pixels counted over all pairs)."""
@@ -81,7 +95,8 @@ def flow_metrics(flow_est: Sequence, flow_gt: Sequence, states: Sequence | None 
     None for a pair without occlusion truth; ``fg_masks``: per pair (H, W) bool foreground (KITTI's
     object map; default background). KITTI's Fl is the devkit's ``flowErrorsOutlier``
     (evaluate_scene_flow.cpp): ``f_err > 3 && f_err / |f*| > 0.05`` on the interpolated estimate,
-    counts pooled over pairs; EPE is computed on the same interpolated estimate."""
+    in the devkit's float arithmetic (:func:`kitti_flow_outliers`), counts pooled over pairs; EPE
+    (float64) is computed on the same interpolated estimate."""
     n = len(flow_est)
     if n == 0 or len(flow_gt) != n:
         raise InputError(f"flow: need as many truth flows as estimates (>0), got {n} and {len(flow_gt)}")
@@ -100,8 +115,7 @@ def flow_metrics(flow_est: Sequence, flow_gt: Sequence, states: Sequence | None 
         ei = kitti_interpolate_flow(e)
         err = np.linalg.norm(ei - np.where(valid_gt[..., None], g, 0.0), axis=2)
         mag = np.linalg.norm(np.where(valid_gt[..., None], g, 0.0), axis=2)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            outlier = (err > abs_thresh_px) & (err / mag > rel_thresh)
+        outlier = kitti_flow_outliers(ei, np.where(valid_gt[..., None], g, 0.0), abs_thresh_px, rel_thresh)
         st = None if states is None or states[k] is None else np.asarray(states[k])
         if st is not None and st.shape != g.shape[:2]:
             raise InputError(f"states #{k}: expected shape {g.shape[:2]}, got {st.shape}")

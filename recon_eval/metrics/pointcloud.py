@@ -11,6 +11,7 @@ nearest reconstructed point (a reconstruction is a cloud). ``distance_rec_to_gt`
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -153,9 +154,9 @@ class Eth3dResult:
     """ETH3D multi-view accuracy / completeness / F1 at one tolerance."""
 
     tolerance_m: float
-    accuracy: float  # per-voxel-averaged fraction of rec points within tolerance of GT, [0, 1]
-    completeness: float  # per-voxel-averaged fraction of GT points within tolerance of rec, [0, 1]
-    f1: float  # 2 A C / (A + C); 0 when both are 0
+    accuracy: float  # per-cell-averaged fraction of rec points within tolerance of GT, [0, 1] (float32 value)
+    completeness: float  # per-cell-averaged fraction of GT points within tolerance of rec, [0, 1] (float32 value)
+    f1: float  # 2 A C / (A + C) in float32; 0 when both are 0
     voxel_m: float  # voxel size for the per-voxel averaging (ETH3D --voxel_size, default 0.01)
     n_rec_scored: int  # reconstructed points scored (observed space only)
     n_rec_unobserved: int  # reconstructed points excluded as lying in unobserved space
@@ -166,13 +167,45 @@ class Eth3dResult:
     benchmark: str = "eth3d_multiview"
 
 
-def _voxel_average(points: np.ndarray, good: np.ndarray, voxel_m: float) -> float:
-    """Mean over occupied voxels (index floor(p / voxel_m)) of the fraction of ``good`` points."""
+#: ETH3D's voxel grids (multi-view-evaluation src/accuracy.cc, completeness.cc ``kGridShifts``):
+#: the cell of a point is floor(p / voxel + shift) on each axis, for the shifts 0 and 0.5 voxel;
+#: the cells of both grids are pooled into one average.
+ETH3D_GRID_SHIFTS = (0.0, 0.5)
+
+
+def _eth3d_cells(points: np.ndarray, voxel_m: float, shift: float) -> np.ndarray:
+    """(N, 3) int64 cell indices as ETH3D's ``CalcCellCoordinates`` computes them, in its float32
+    arithmetic: ``float(p) * voxel_size_inv + shift`` rounded to float32 at each step, floored;
+    ``voxel_size_inv = (float)(1.0 / voxel_size)`` with ``voxel_size`` a float (main.cc)."""
+    inv = np.float32(1.0 / np.float64(np.float32(voxel_m)))
+    return np.floor(points.astype(np.float32) * inv + np.float32(shift)).astype(np.int64)
+
+
+def _eth3d_voxel_average(points: np.ndarray, good: np.ndarray, voxel_m: float, *, float_cells: bool) -> np.float32:
+    """ETH3D's density-cancelling average: over the occupied cells of both grids
+    (:data:`ETH3D_GRID_SHIFTS`), pooled, the fraction of ``good`` points in the cell; the
+    fractions summed in double and the mean stored as a float. The cell fraction is a float
+    division for accuracy (``accurate / (1.0f * valid)``, ``float_cells``) and a double one for
+    completeness (``complete / (1.0 * count)``), as in accuracy.cc and completeness.cc."""
     if len(points) == 0:
-        return 0.0
-    inv, counts = _group_voxels(np.floor(points / voxel_m).astype(np.int64))
-    frac = np.bincount(inv, weights=good.astype(np.float64), minlength=len(counts)) / counts
-    return float(np.mean(frac))
+        return np.float32(0.0)
+    fractions = []
+    for shift in ETH3D_GRID_SHIFTS:
+        inv, counts = _group_voxels(_eth3d_cells(points, voxel_m, shift))
+        n_good = np.bincount(inv, weights=good.astype(np.float64), minlength=len(counts))
+        if float_cells:
+            fractions.append((n_good.astype(np.float32) / counts.astype(np.float32)).astype(np.float64))
+        else:
+            fractions.append(n_good / counts)
+    f = np.concatenate(fractions)
+    return np.float32(math.fsum(f) / len(f))
+
+
+def _eth3d_f1(accuracy: np.float32, completeness: np.float32) -> np.float32:
+    """main.cc's F1 in float: 0 when both are <= 0, else 2 (P R) / (P + R)."""
+    if accuracy <= 0 and completeness <= 0:
+        return np.float32(0.0)
+    return np.float32(2) * (accuracy * completeness) / (accuracy + completeness)
 
 
 def eth3d(
@@ -190,8 +223,11 @@ def eth3d(
     (``<=``). Accuracy: a reconstructed point is accurate if within the tolerance of the GT
     (``<=``); points in unobserved space (``rec_observed`` False, (N,) bool; default all observed)
     are excluded. Both are averaged per voxel of size ``voxel_m`` (ETH3D's ``--voxel_size``,
-    default 0.01 m) to cancel density: the score is the mean over occupied voxels of the fraction
-    of good points in the voxel. F1 = 2AC/(A+C), 0 when both are 0. Empty cloud -> 0.
+    default 0.01 m) to cancel density: the score is the mean, over the occupied cells of two
+    grids shifted by 0 and 0.5 voxel and pooled, of the fraction of good points in the cell
+    (:func:`_eth3d_voxel_average`). F1 = 2AC/(A+C), 0 when both are 0. Empty cloud -> 0. The cell
+    indices, fractions, means and F1 follow ETH3D's float32 arithmetic, so the three scores are
+    float32 values, equal to the evaluator's for the same per-point classification.
     ETH3D tolerances: 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 m. (:func:`eth3d_table` at one tolerance.)
     """
     return eth3d_table(points_rec, points_gt, (tolerance_m,), gt_mesh=gt_mesh, rec_observed=rec_observed,
@@ -223,9 +259,10 @@ def eth3d_table(points_rec, points_gt, tolerances_m=ETH3D_TOLERANCES_M, *, gt_me
     d_gr = nearest_point_distances(gt, rec_s, upper_bound_m=max(tols) * (1.0 + _BOUND_SLACK))
     out = []
     for t in tols:
-        acc = _voxel_average(rec_s, d_rg <= t, voxel_m)
-        comp = _voxel_average(gt, d_gr <= t, voxel_m)
-        out.append(Eth3dResult(t, acc, comp, _fscore(acc, comp), voxel_m, len(rec_s), n_un, len(gt), to.value))
+        acc = _eth3d_voxel_average(rec_s, d_rg <= t, voxel_m, float_cells=True)
+        comp = _eth3d_voxel_average(gt, d_gr <= t, voxel_m, float_cells=False)
+        out.append(Eth3dResult(t, float(acc), float(comp), float(_eth3d_f1(acc, comp)), voxel_m, len(rec_s), n_un,
+                               len(gt), to.value))
     return tuple(out)
 
 

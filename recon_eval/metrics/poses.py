@@ -21,7 +21,7 @@ import numpy as np
 from recon_eval.arrays import as_float_array, frozen
 from recon_eval.errors import InputError
 from recon_eval.metrics.align import Alignment, Sim3, umeyama
-from recon_eval.metrics.stats import ErrorStats, error_stats, recall_auc
+from recon_eval.metrics.stats import ErrorStats, error_stats, maa_deg, recall_auc
 from scenegen.geometry.rotation import angle_between_vectors_rad, rotation_error_rad
 
 
@@ -343,21 +343,6 @@ def relative_pose_errors_deg(R_est, t_est, R_gt, t_gt) -> tuple[np.ndarray, np.n
     pose = np.where(gt_zero, eR, np.maximum(eR, et))
     eR[bad], et[bad], pose[bad] = np.inf, np.inf, np.inf
     return eR, et, pose
-
-
-def maa_deg(pose_err_deg, max_threshold_deg: int = 10) -> float:
-    """Image Matching Benchmark mean average accuracy (ubc-vision/image-matching-benchmark,
-    utils/pack_helper.py ``compute_qt_auc``): ``np.histogram`` of the pose errors (max(err_q, err_t),
-    degrees) over the bins ``np.arange(max + 1)``, cumulated and averaged over the ``max`` thresholds.
-    numpy closes the last bin, so at thresholds 1 .. max-1 a pair counts when ``err < th`` and at
-    the last threshold when ``err <= max``. Failures (inf, NaN) are misses (IMB maps inf to 1e6).
-    Discrete: not the same number as the AUC. Empty -> 0."""
-    e = np.asarray(pose_err_deg, float).reshape(-1)
-    if len(e) == 0:
-        return 0.0
-    e = np.where(np.isfinite(e), e, 1e6)
-    hist, _ = np.histogram(e, np.arange(max_threshold_deg + 1))
-    return float(np.mean(np.cumsum(hist.astype(float) / len(e))))
 
 
 @dataclass(frozen=True)

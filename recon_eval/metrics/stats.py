@@ -1,9 +1,12 @@
-"""Summary statistics (evo's set) and recall-curve areas shared by several metric families."""
+"""Summary statistics (evo's set), recall-curve areas and the Image Matching Benchmark's mAA, shared by
+several metric families."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from recon_eval.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -60,3 +63,28 @@ def recall_auc(errors, thresholds) -> tuple[float, ...]:
         x = np.r_[e[:last], t]
         out.append(float(np.trapezoid(r, x=x) / t))
     return tuple(out)
+
+
+#: The Image Matching Benchmark's pose-accuracy histogram: bins [0, 1), [1, 2), ..., [9, 10] degrees.
+IMB_BINS_DEG = np.arange(11)
+
+
+def maa_deg(pose_err_deg, max_threshold_deg: int = 10) -> float:
+    """Image Matching Benchmark mean average accuracy (ubc-vision/image-matching-benchmark,
+    utils/pack_helper.py ``compute_qt_auc``): ``np.histogram`` of the pose errors (max(err_q, err_t),
+    degrees) over its 10 bins ``np.arange(11)``, divided by the pair count and cumulated; mAA@m is
+    the mean of the first ``m`` cumulated values (IMB's ``qt_auc_05`` = ``np.mean(qt_acc[:5])``,
+    ``qt_auc_10`` = ``np.mean(qt_acc)``). numpy closes only the last bin, so at thresholds 1 .. 9 a
+    pair counts when ``err < th`` and at 10 when ``err <= 10``: an error of exactly 5 deg does not
+    count in mAA@5. ``max_threshold_deg``: 1 .. 10. Failures (inf, NaN) are misses (IMB maps inf to
+    1e6). Discrete: not the same number as the AUC. Empty -> 0."""
+    m = int(max_threshold_deg)
+    if m != max_threshold_deg or not 1 <= m <= 10:
+        raise InputError(f"mAA: max_threshold_deg: expected an integer 1 .. 10 (the Image Matching Benchmark's "
+                         f"histogram has 10 one-degree bins), got {max_threshold_deg!r}")
+    e = np.asarray(pose_err_deg, float).reshape(-1)
+    if len(e) == 0:
+        return 0.0
+    e = np.where(np.isfinite(e), e, 1e6)
+    hist, _ = np.histogram(e, IMB_BINS_DEG)
+    return float(np.mean(np.cumsum(hist.astype(float) / float(len(e)))[:m]))

@@ -100,7 +100,8 @@ def kitti_d1(
     rel_thresh: float = 0.05,
 ) -> KittiD1Result:
     """KITTI 2015 D1 (Menze & Geiger, CVPR 2015; devkit ``disp_err`` in io_disp.h): a pixel is an
-    outlier if ``|d - d*| > 3 px AND |d - d*| / |d*| > 5 %``. Missing estimates (NaN or negative:
+    outlier if ``|d - d*| > 3 px AND |d - d*| / |d*| > 5 %``, in the devkit's float arithmetic
+    (:func:`kitti_disparity_outliers`). Missing estimates (NaN or negative:
     the devkit's ``isValid`` is ``d >= 0``) are filled by :func:`kitti_interpolate_background` and
     still scored; pixels nothing fills (an image or an interior row without any estimate) keep the
     devkit's invalid value -1 and are scored with it. Density is reported, and the devkit's "est"
@@ -135,9 +136,7 @@ def kitti_d1(
         ei[~np.isfinite(ei)] = -1.0  # the devkit's invalid value, left where nothing interpolates
         for name, g in (("noc", g_noc), ("occ", g_occ)):
             valid = np.isfinite(g) & (g > 0)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                err = np.abs(ei - g)
-                out = (err > abs_thresh_px) & (err / np.abs(g) > rel_thresh)
+            out = kitti_disparity_outliers(ei, g, abs_thresh_px, rel_thresh)
             for region, mask in (("bg", ~fg), ("fg", fg)):
                 for suffix, sel in (("", valid & mask), ("_est", valid & mask & est_valid)):
                     bad[f"{region}_{name}{suffix}"] += int((out & sel).sum())
@@ -157,6 +156,18 @@ def kitti_d1(
         d1_all_noc_est_pct=noc_est[2], d1_bg_occ_est_pct=occ_est[0], d1_fg_occ_est_pct=occ_est[1],
         d1_all_occ_est_pct=occ_est[2],
     )
+
+
+def kitti_disparity_outliers(disp_ipol, disp_gt, abs_thresh_px: float = 3.0, rel_thresh: float = 0.05) -> np.ndarray:
+    """(H, W) bool ``d_err`` of the devkit's ``disparityErrorsOutlier`` (evaluate_scene_flow.cpp)
+    in its arithmetic: the disparities are floats, ``fabs`` is the float overload, so ``|d* - d|``
+    and ``|d* - d| / |d*|`` are float32 values, compared with the double constants 3.0 and 0.05.
+    The float quotient matters at exact ties, which the KITTI PNG's 1/256 px grid makes common:
+    5 / 100 in float is 0.0500000007 > 0.05, an outlier (in float64 it is not)."""
+    g = np.asarray(disp_gt, np.float32)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        err = np.abs(g - np.asarray(disp_ipol, np.float32))  # float32
+        return (err.astype(np.float64) > abs_thresh_px) & ((err / np.abs(g)).astype(np.float64) > rel_thresh)
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from recon_eval.errors import InputError
 from recon_eval.metrics.features import CorrespondenceMap
-from scenegen.dataset.codecs import read_exr
+from recon_eval.readers.native import read_exr
 from scenegen.dataset.crossview import decode_correspondence_channels
 
 

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from scenegen.dataset.codecs import read_exr, write_exr
+from recon_eval.readers.native import read_exr
+from scenegen.dataset.codecs import write_exr
 
 DEPTH_CHANNELS = ("depth_z", "depth", "Z", "Y", "R")
 DISPARITY_CHANNELS = ("disparity", "disp", "Y", "R")

@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from scenegen.dataset.codecs import decode_flo, encode_png, read_npy, read_pfm, read_png
+from recon_eval.readers.native import read_png
+from scenegen.dataset.codecs import decode_flo, encode_png, read_npy, read_pfm
 from scenegen.dataset.codecs.kitti_flow import (  # the format lives with the dataset codecs
     KITTI_FLOW_OFFSET, KITTI_FLOW_SCALE, decode_kitti_flow, encode_kitti_flow,
 )
@@ -57,7 +58,7 @@ def read_flow(path) -> np.ndarray:
             if a.ndim != 3 or a.shape[2] < 2:
                 raise ValueError(f"expected a colour (3-channel) PFM holding (u, v, 0), got {a.shape}")
             f = a[..., :2].copy()
-    except (ValueError, EOFError) as exc:
-        raise InputError(f"{p}: {exc}") from None
+    except (ValueError, EOFError) as exc:  # the codecs' read_* name the file already
+        raise InputError(f"{p}: {str(exc).removeprefix(f'{p}: ')}") from None
     f[~np.all(np.isfinite(f), axis=2)] = np.nan
     return f

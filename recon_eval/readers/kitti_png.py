@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from scenegen.dataset.codecs import decode_kitti_disparity, encode_kitti_disparity, read_png
+from recon_eval.readers.native import quiet_native_output, read_png
+from scenegen.dataset.codecs import decode_kitti_disparity, encode_kitti_disparity
 from scenegen.dataset.files import atomic_write_bytes
 
 
@@ -18,7 +19,8 @@ def read_kitti_disparity(path) -> np.ndarray:
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a KITTI uint16 disparity PNG)")
     try:
-        d, valid = decode_kitti_disparity(p.read_bytes())
+        with quiet_native_output():  # libpng's own messages
+            d, valid = decode_kitti_disparity(p.read_bytes())
     except ValueError as exc:  # not a PNG, or not single-channel uint16
         raise InputError(f"{p}: {exc} (expected a KITTI uint16 disparity PNG)") from None
     d[~valid] = np.nan

@@ -10,7 +10,7 @@ import numpy as np
 
 from recon_eval.errors import InputError
 from recon_eval.readers.text import read_text
-from scenegen.dataset.codecs import read_png
+from recon_eval.readers.native import read_png
 
 CALIB = "calib.txt"
 

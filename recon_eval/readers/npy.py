@@ -18,7 +18,7 @@ def read_npy(path, shape: tuple | None = None) -> np.ndarray:
     try:
         a = decode_npy_file(p)
     except (ValueError, OSError, EOFError) as exc:
-        raise InputError(f"{p}: not a readable .npy array ({exc})") from None
+        raise InputError(f"{p}: not a readable .npy array ({str(exc).removeprefix(f'{p}: ')})") from None
     if not np.issubdtype(a.dtype, np.number) and a.dtype != bool:
         raise InputError(f"{p}: expected a numeric array, got dtype {a.dtype}")
     if shape is not None:

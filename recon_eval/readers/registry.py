@@ -32,7 +32,7 @@ from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.readers.text import read_text
 from recon_eval.readers.tum import read_tum
 from scenegen.dataset import CAMERAS
-from scenegen.dataset.codecs import read_png
+from recon_eval.readers.native import read_png
 
 # --- maps --------------------------------------------------------------------------------------
 #: suffix -> reader(path, kind) of an (H, W) float64 map, NaN = missing ("depth" or "disparity"

@@ -7,12 +7,12 @@ own key) or ``tracks``; occlusion ``occluded`` (True = occluded), or ``visibles`
 """
 from __future__ import annotations
 
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from recon_eval.errors import InputError
+from scenegen.dataset.codecs import decode_npz
 
 POSITION_KEYS = ("tracks_xy", "tracks")
 OCCLUDED_KEYS = ("occluded",)
@@ -23,10 +23,11 @@ def read_tracks(path, n_tracks: int, n_frames: int) -> tuple[np.ndarray, np.ndar
     """(tracks (N, T, 2) float64 px, occluded (N, T) bool) of the ``.npz`` at ``path``, checked
     against the truth's ``n_tracks`` x ``n_frames``."""
     p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{p}: no such file (expected a pickle-free .npz of tracks)")
     try:
-        with np.load(p, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
+        arrays = decode_npz(p.read_bytes())  # every declared array size checked before allocating
+    except (OSError, ValueError) as e:
         raise InputError(f"{p}: not a readable pickle-free .npz of tracks ({e})") from None
     pos_key = next((k for k in POSITION_KEYS if k in arrays), None)
     if pos_key is None:

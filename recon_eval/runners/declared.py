@@ -11,33 +11,36 @@ names file:line: field)::
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from recon_eval.errors import InputError
 from recon_eval.runners import FAULTS, METHODS, Method
-from recon_eval.runners.external import KINDS, PIXELS, TIMEOUT_S, check_command
-from scenegen.dataset.layout import NAME_RE
+from recon_eval.runners.external import CLI, KINDS, PIXELS, TIMEOUT_S, check_command, field_at
+from scenegen.dataset.layout import MAX_NAME_LEN, NAME_RE
 from scenegen.located_yaml.source import read_source
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Node
 
 
 def external_method(name: str, kind: str, command: str, *, timeout_s: float = TIMEOUT_S, pixels: str | None = None,
-                    description: str = "", declared_at: str = "--command") -> Method:
-    """The :class:`Method` running ``command`` as an estimator of output ``kind``; InputError
-    (naming ``declared_at``) for a bad name, kind, command, timeout or pixels."""
-    if not isinstance(name, str) or not NAME_RE.match(name):
-        raise InputError(f"{declared_at}: name: {name!r}: expected letters, digits, '_', '.', '-' (starting with a "
-                         f"letter or digit)")
+                    description: str = "", declared_at: str = CLI) -> Method:
+    """The :class:`Method` running ``command`` as an estimator of output ``kind``; InputError for a
+    bad name, kind, command, timeout or pixels, naming the option (``declared_at`` :data:`CLI`:
+    ``recon-eval run --command``) or ``declared_at: field`` (a methods file's FILE:LINE)."""
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > MAX_NAME_LEN:
+        raise InputError(f"{field_at(declared_at, 'name')}: {name!r}: expected 1-{MAX_NAME_LEN} letters, digits, "
+                         f"'_', '.', '-' (starting with a letter or digit)")
     if name in METHODS or name in FAULTS:
-        raise InputError(f"{declared_at}: name: {name!r} is a built-in method; choose another name")
+        raise InputError(f"{field_at(declared_at, 'name')}: {name!r} is a built-in method; choose another name")
     check_command(command, kind, declared_at)
-    if not (timeout_s > 0):
-        raise InputError(f"{declared_at}: timeout_s: expected a number > 0, got {timeout_s!r}")
-    opts = {"command": command, "kind": kind, "timeout_s": float(timeout_s), "declared_at": declared_at}
+    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
+        raise InputError(f"{field_at(declared_at, 'timeout_s')}: expected a finite number of seconds > 0, got "
+                         f"{timeout_s!r}")
+    opts = {"name": name, "command": command, "kind": kind, "timeout_s": float(timeout_s), "declared_at": declared_at}
     if pixels is not None:
         if kind != "fmatrix" or pixels not in PIXELS:
-            raise InputError(f"{declared_at}: pixels: only for kind fmatrix, one of {', '.join(PIXELS)}")
+            raise InputError(f"{field_at(declared_at, 'pixels')}: only for kind fmatrix, one of {', '.join(PIXELS)}")
         opts["pixels"] = pixels
     return Method(name, "external", KINDS[kind].function, description or f"external {kind}: {command}",
                   tuple(sorted(opts.items())))
@@ -74,8 +77,8 @@ def _method(item: Node) -> Method:
     kind = f.req("kind").as_enum(list(KINDS), "the output kind")
     timeout = f.get("timeout_s")
     t = TIMEOUT_S if timeout is None else timeout.as_float()
-    if not t > 0:
-        raise timeout.error(f"expected a number of seconds > 0, got {timeout.describe()}")
+    if not (math.isfinite(t) and t > 0):
+        raise timeout.error(f"expected a finite number of seconds > 0, got {timeout.describe()}")
     pixels = f.get("pixels")
     desc = f.get("description")
     try:

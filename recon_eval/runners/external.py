@@ -31,7 +31,6 @@ from __future__ import annotations
 import re
 import shlex
 import shutil
-import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,6 +43,7 @@ from recon_eval.readers.npy import read_mask
 from recon_eval.readers.pfm import read_pfm
 from recon_eval.runners import calibration as calib, colmap, stereo, twoview
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from recon_eval.runners.process_group import run_group
 from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
 from scenegen.dataset.layout import check_view_name
 
@@ -82,29 +82,41 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "image names <view>.png) into the folder {out}; scored as pycolmap-incremental"),
 ]}
 ALWAYS = ("python", "dataset")
+#: ``declared_at`` of a method made by ``recon-eval run --command``, and the option of each field
+#: there: its errors name what the user typed (a methods file's name FILE:LINE: field).
+CLI = "--command"
+CLI_OPTIONS = {"name": "--name", "kind": "--kind", "command": "--command", "timeout_s": "--timeout",
+               "pixels": "--pixels"}
+
+
+def field_at(declared_at: str, field: str) -> str:
+    """Where an error about a method's ``field`` points: its option, for a method declared on the
+    command line (``declared_at`` :data:`CLI`), else ``<declared_at>: <field>``."""
+    return CLI_OPTIONS[field] if declared_at == CLI else f"{declared_at}: {field}"
 
 
 def check_command(command: str, kind: str, where: str) -> list[str]:
     """The argument list of ``command`` (shlex), checked: known kind, placeholders of that kind,
     ``{out}`` used; InputError naming ``where`` otherwise."""
     if kind not in KINDS:
-        raise InputError(f"{where}: kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+        raise InputError(f"{field_at(where, 'kind')}: expected one of {', '.join(KINDS)}, got {kind!r}")
     try:
         argv = shlex.split(command)
     except ValueError as exc:
-        raise InputError(f"{where}: command: cannot split {command!r} ({exc})") from None
+        raise InputError(f"{field_at(where, 'command')}: cannot split {command!r} ({exc})") from None
     if not argv:
-        raise InputError(f"{where}: command: empty")
+        raise InputError(f"{field_at(where, 'command')}: empty")
     allowed = set(KINDS[kind].placeholders) | set(ALWAYS)
     used = {m for tok in argv for m in PLACEHOLDER.findall(tok)}
     unknown = sorted(used - allowed)
     if unknown:
-        raise InputError(f"{where}: command: unknown placeholder {{{unknown[0]}}} for kind {kind!r} (known: "
+        raise InputError(f"{field_at(where, 'command')}: unknown placeholder {{{unknown[0]}}} for kind {kind!r} "
+                         f"(known: "
                          f"{', '.join('{' + n + '}' for n in KINDS[kind].placeholders + ALWAYS)})")
     if "out" not in used:
-        raise InputError(f"{where}: command: needs {{out}}, where the method writes its output")
+        raise InputError(f"{field_at(where, 'command')}: needs {{out}}, where the method writes its output")
     if kind == "fmatrix" and "matches" in used and used & {"images", "image1", "image2"}:
-        raise InputError(f"{where}: command: use {{matches}} or the images, not both")
+        raise InputError(f"{field_at(where, 'command')}: use {{matches}} or the images, not both")
     return argv
 
 
@@ -131,25 +143,30 @@ def substitute(argv: list[str], values: dict) -> list[str]:
 def invoke(options: dict, values: dict, log_dir: Path, item: str, out) -> str | None:
     """Run the method's command for one item; None on success, else why it failed (also recorded
     in ``out.notes[item]`` with the tail of stderr). A command that cannot start is bad input."""
-    argv = substitute(check_command(options["command"], options["kind"], options.get("declared_at", "command")),
+    argv = substitute(check_command(options["command"], options["kind"], options.get("declared_at", CLI)),
                       {"python": sys.executable, **values})
     log_dir.mkdir(parents=True, exist_ok=True)
     timeout = float(options.get("timeout_s", TIMEOUT_S))
-    try:
-        r = subprocess.run(argv, stdin=subprocess.DEVNULL, capture_output=True, timeout=timeout, check=False)
-        stdout, stderr, why = r.stdout, r.stderr, None if r.returncode == 0 else f"exit status {r.returncode}"
-    except subprocess.TimeoutExpired as exc:
-        stdout, stderr, why = exc.stdout or b"", exc.stderr or b"", f"timed out after {timeout:g} s"
+    try:  # in its own process group, killed with the command (runners/process_group.py)
+        status = run_group(argv, log_dir / "stdout.txt", log_dir / "stderr.txt", timeout)
     except OSError as exc:
-        raise InputError(f"method {options.get('name')!r}: cannot run {argv[0]!r}: {exc.strerror or exc}") from None
-    (log_dir / "stdout.txt").write_bytes(stdout)
-    (log_dir / "stderr.txt").write_bytes(stderr)
+        where = "" if options.get("declared_at", CLI) == CLI else f"{options['declared_at']}: "  # the methods file
+        raise InputError(f"{where}method {options['name']!r}: cannot run {argv[0]!r}: {exc.strerror or exc}") from None
+    why = (f"timed out after {timeout:g} s" if status is None else None if status == 0 else
+           f"killed by signal {-status}" if status < 0 else f"exit status {status}")
     if why is not None:
-        tail = stderr.decode("utf-8", "replace").strip().splitlines()[-STDERR_LINES:]
+        tail = _last_lines(log_dir / "stderr.txt")
         out.notes[item] = {"failed": why, "stderr_tail": tail, "argv": argv}
-        print(f"recon-eval: {options.get('name')}: {item}: {why}" + (f": {tail[-1]}" if tail else ""),
+        print(f"recon-eval: {options['name']}: {item}: {why}" + (f": {tail[-1]}" if tail else ""),
               file=sys.stderr)
     return why
+
+
+def _last_lines(path: Path) -> list[str]:
+    """The last :data:`STDERR_LINES` lines of a log file (of its last 64 KiB)."""
+    with open(path, "rb") as f:
+        f.seek(max(0, f.seek(0, 2) - (64 << 10)))
+        return f.read().decode("utf-8", "replace").strip().splitlines()[-STDERR_LINES:]
 
 
 def _failed_output(out, item: str, why: str) -> None:
@@ -170,12 +187,12 @@ def _read_f(path: Path, out, item: str):
 
 def fmatrix(ds, out_dir, options) -> RunOutput:
     """The ``fmatrix`` kind (:data:`KINDS`)."""
-    argv = check_command(options["command"], "fmatrix", options.get("declared_at", "command"))
+    argv = check_command(options["command"], "fmatrix", options.get("declared_at", CLI))
     if any("{matches}" in t for t in argv):
         return _fmatrix_matches(ds, out_dir, options)
     pixels = options.get("pixels", "distorted")
     if pixels not in PIXELS:
-        raise InputError(f"{options.get('declared_at', 'method')}: pixels: expected one of {', '.join(PIXELS)}")
+        raise InputError(f"{field_at(options.get('declared_at', CLI), 'pixels')}: expected one of {', '.join(PIXELS)}")
     pairs = crossview_pairs(ds)
     out = RunOutput()
     for i, j in pairs:

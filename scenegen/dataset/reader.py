@@ -97,7 +97,7 @@ class Dataset:
         try:
             return reader(p)
         except (ValueError, KeyError, OSError) as e:
-            raise DatasetError(f"{p}: unreadable {what}: {e}") from None
+            raise DatasetError(f"{p}: unreadable {what}: {str(e).removeprefix(f'{p}: ')}") from None
 
     # --- views and cameras
     @property

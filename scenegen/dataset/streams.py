@@ -21,7 +21,7 @@ from typing import Mapping
 
 import numpy as np
 
-from scenegen.dataset.codecs.npz import decode_npz, encode_npz
+from scenegen.dataset.codecs.npy import decode_npz, encode_npz
 from scenegen.dataset.layout import check_name, stream_chunk_path
 
 STREAM_FORMAT_VERSION = 1

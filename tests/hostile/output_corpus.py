@@ -6,8 +6,16 @@ from __future__ import annotations
 
 import io
 import json
+import sys
+import zipfile
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))
+from hostile_data import good_tracks  # noqa: E402
+
+from scenegen.dataset.codecs import TRACK_KEYS, encode_exr, encode_png  # noqa: E402
 
 ROT = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
 GOOD_POSE = {"R": ROT, "t": [0.1, 0.2, 3.0]}
@@ -15,6 +23,8 @@ H_GOOD = "1 0.01 2\n0.02 1 -3\n0.0001 0 1\n"
 DEEP_JSON = "[" * 100_000 + "]" * 100_000
 UTF16 = "1 0 0\n".encode("utf-16")
 BINARY = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\xff"
+TRUNCATED_EXR = encode_exr({"depth_z": np.full((6, 8), 2.0, np.float32)})[:-10]  # OpenEXR prints to stdout and stderr
+TRUNCATED_PNG = encode_png(np.full((6, 8), 512, np.uint16))[:-5]  # libpng prints "libpng error: ..."
 
 
 def npy_bytes(a) -> bytes:
@@ -174,3 +184,97 @@ case("gate_utf16", "gate", "gate.yaml", G.encode("utf-16"), "UTF-16 encoded")
 case("gate_directory", "gate", "gate.yaml", None, "is a directory")
 case("gate_results_deep_json", "gate", "result.json", DEEP_JSON, "nested too deeply")
 case("gate_results_invalid", "gate", "result.json", "{", "invalid JSON")
+# --- issue 25: sizes declared in NPY headers, truth tracks, .flo, images and EXRs through C libraries --
+def npy_header(shape, descr="<f4") -> bytes:
+    """An NPY file that is only a header: it declares ``shape`` and holds no data."""
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": descr, "fortran_order": False, "shape": shape})
+    return buf.getvalue()
+
+
+def npz_bytes(members: dict, compression=zipfile.ZIP_STORED) -> bytes:
+    """An NPZ of ``{member name: bytes}``, written member by member (headers may lie)."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=compression) as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+    return buf.getvalue()
+
+
+def tracks_npz(tracks_xy, occluded) -> bytes:
+    return npz_bytes({"tracks_xy.npy": npy_bytes(np.asarray(tracks_xy)), "occluded.npy": npy_bytes(np.asarray(occluded))})
+
+
+GOOD_TRACKS = good_tracks()
+OCC = npy_bytes(GOOD_TRACKS.occluded)
+BOMB = npy_header((20_000_000_000,))  # 74.5 GiB of float32 declared in 128 bytes
+case("tracks_ok", "tracks", "pred.npz", tracks_npz(GOOD_TRACKS.tracks_xy, GOOD_TRACKS.occluded), "average_jaccard", 0)
+case("tracks_npz_header_claims_74_gib", "tracks", "pred.npz", npz_bytes({"tracks_xy.npy": BOMB, "occluded.npy": OCC}),
+     "member 'tracks_xy.npy': the header declares shape (20000000000,) of float32 (80,000,000,000 bytes), but the "
+     "file holds 0 bytes")
+case("tracks_npz_deflated_header_claims_74_gib", "tracks", "pred.npz",
+     npz_bytes({"tracks_xy.npy": BOMB, "occluded.npy": OCC}, zipfile.ZIP_DEFLATED), "(80,000,000,000 bytes)")
+case("tracks_npz_header_within_file_over_limit", "tracks", "pred.npz",
+     npz_bytes({"tracks_xy.npy": npy_header((3, 2, 2**30))}), "at most 4 GiB")
+case("tracks_npz_header_longer_than_data", "tracks", "pred.npz",
+     npz_bytes({"tracks_xy.npy": npy_bytes(np.zeros((3, 2, 2), np.float32))[:-8], "occluded.npy": OCC}),
+     "(48 bytes), but the file holds 40 bytes")
+case("tracks_npz_negative_shape", "tracks", "pred.npz", npz_bytes({"tracks_xy.npy": npy_header((-1, 2, 2))}),
+     "expected non-negative dimensions")
+case("tracks_npz_pickle", "tracks", "pred.npz", npz_bytes({"tracks_xy.npy": npy_bytes(np.array([{}], dtype=object))}),
+     "an object array (it needs pickle")
+case("tracks_npz_not_npy_member", "tracks", "pred.npz", npz_bytes({"tracks_xy.txt": b"1 2"}),
+     "expected members with distinct names <key>.npy")
+case("tracks_npz_duplicate_member", "tracks", "pred.npz",
+     npz_bytes({"tracks_xy.npy": npy_bytes(GOOD_TRACKS.tracks_xy), "occluded.npy": OCC, "tracks_xy.np_": OCC})
+     .replace(b"tracks_xy.np_", b"tracks_xy.npy"),
+     "expected members with distinct names <key>.npy")
+case("tracks_shape", "tracks", "pred.npz", tracks_npz(GOOD_TRACKS.tracks_xy[:, :1], GOOD_TRACKS.occluded),
+     "tracks_xy: expected numbers of shape (3, 2, 2)")
+case("tracks_not_a_zip", "tracks", "pred.npz", BINARY, "not a readable pickle-free .npz of tracks")
+case("tracks_truth_nan_where_visible", "tracks_truth", "truth.npz", npz_bytes({
+    f"{k}.npy": npy_bytes(np.full_like(GOOD_TRACKS.tracks_xy, np.nan) if k == "tracks_xy" else getattr(GOOD_TRACKS, k))
+    for k in TRACK_KEYS}),
+     "tracks: tracks_xy[0, 0] is not finite where the point is visible (expected finite pixel coordinates")
+case("depth_npy_header_claims_74_gib", "depth", "d.npy", BOMB, "the header declares shape (20000000000,) of float32")
+case("depth_exr_truncated", "depth", "d.exr", TRUNCATED_EXR, "not a readable EXR file")
+case("depth_png_truncated", "depth", "d.png", TRUNCATED_PNG, "not a readable PNG")
+FLO_HEAD = np.array([202021.25], "<f4").tobytes() + np.array([4, 3], "<i4").tobytes()
+case("flow_ok", "flow", "f.flo", FLO_HEAD + np.zeros(24, "<f4").tobytes(), "epe", 0)
+case("flow_flo_magic", "flow", "f.flo", b"\x00" * 20,
+     "not a .flo file (magic 0, bytes b'\\x00\\x00\\x00\\x00'; expected 202021.25, bytes b'PIEH')")
+case("flow_flo_truncated", "flow", "f.flo", FLO_HEAD + b"\x00" * 8,
+     "expected sizes >= 1 and 12 + 8 * W * H = 108 bytes")
+case("flow_flo_short", "flow", "f.flo", b"PIEH", "expected a 12-byte header")
+case("flow_flo_huge_size", "flow", "f.flo", FLO_HEAD[:4] + np.array([2**31 - 1] * 2, "<i4").tobytes(),
+     "a .flo header of width 2147483647 and height 2147483647")
+case("flow_png_truncated", "flow", "f.png", TRUNCATED_PNG, "not a readable PNG")
+# --- run: a user's estimator (--command, --methods-file); FILE is the case's file, DS the dataset ----
+RUN = ("--kind", "sfm", "DS", "-o", "RUNS")
+EXIT_1 = "import sys; sys.exit(1)\n"
+case("run_timeout_zero", "run", "est.py", EXIT_1, "--timeout: expected a finite number of seconds > 0, got 0.0", 2,
+     ("--command", "{python} FILE {images} {out}", "--timeout", "0", *RUN))
+case("run_timeout_nan", "run", "est.py", EXIT_1, "--timeout: expected a finite number of seconds > 0, got nan", 2,
+     ("--command", "{python} FILE {images} {out}", "--timeout", "nan", *RUN))
+case("run_timeout_inf", "run", "est.py", EXIT_1, "--timeout: expected a finite number of seconds > 0, got inf", 2,
+     ("--command", "{python} FILE {images} {out}", "--timeout", "inf", *RUN))
+case("run_name_path", "run", "est.py", EXIT_1, "--name: '../x': expected 1-128 letters, digits", 2,
+     ("--command", "{python} FILE {images} {out}", "--name", "../x", *RUN))
+case("run_name_builtin", "run", "est.py", EXIT_1, "--name: 'opencv-f-8point' is a built-in method", 2,
+     ("--command", "{python} FILE {images} {out}", "--name", "opencv-f-8point", *RUN))
+case("run_command_no_out", "run", "est.py", EXIT_1, "--command: needs {out}", 2, ("--command", "{python} FILE", *RUN))
+case("run_cannot_start", "run", "est.py", EXIT_1, "method 'my-est': cannot run '/nonexistent/prog'", 2,
+     ("--command", "/nonexistent/prog FILE {images} {out}", "--name", "my-est", *RUN))
+case("run_exit_status_names_the_method", "run", "est.py", EXIT_1, "recon-eval: my-est: sfm: exit status 1", 0,
+     ("--command", "{python} FILE {images} {out}", "--name", "my-est", *RUN))
+METHODS = "version: 1\nmethods:\n  - {name: filed, kind: sfm, command: '%s {images} {out}'%s}\n"
+case("run_methods_file_cannot_start", "run", "m.yaml", METHODS % ("/nonexistent/prog", ""),
+     "method 'filed': cannot run '/nonexistent/prog'", 2, ("filed", "DS", "-o", "RUNS", "--methods-file", "FILE"))
+case("run_methods_file_timeout_zero", "run", "m.yaml", METHODS % ("false", ", timeout_s: 0"),
+     "m.yaml:3: methods[0].timeout_s: expected a finite number of seconds > 0, got 0", 2,
+     ("filed", "DS", "-o", "RUNS", "--methods-file", "FILE"))
+case("run_methods_file_exit_status", "run", "m.yaml", METHODS % ("false", ""), "recon-eval: filed: sfm: exit status 1",
+     0, ("filed", "DS", "-o", "RUNS", "--methods-file", "FILE"))
+case("run_methods_file_timeout_nan", "run", "m.yaml", METHODS % ("false", ", timeout_s: .nan"),
+     "m.yaml:3: methods[0].timeout_s: expected a finite number", 2,
+     ("filed", "DS", "-o", "RUNS", "--methods-file", "FILE"))

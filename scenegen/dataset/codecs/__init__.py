@@ -8,12 +8,11 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.json`: canonical JSON.
 * :mod:`.png`: uint8/uint16 grey or RGB images.
 * :mod:`.exr`: named float32/uint32 channels; vectors as ``<prefix>.<component>``.
-* :mod:`.npy`: arrays without pickles.
+* :mod:`.npy`: arrays (``.npy``) and archives of arrays (``.npz``) without pickles, sizes checked.
 * :mod:`.pfm`: Middlebury/ETH3D float maps.
 * :mod:`.kitti`: KITTI uint16 disparity PNGs; :mod:`.kitti_flow`: KITTI 16-bit RGB flow PNGs.
 * :mod:`.flo`: Middlebury optical flow.
 * :mod:`.sintel`: MPI-Sintel depth (``.dpt``) and camera (``.cam``) files.
-* :mod:`.npz`: pickle-free NPZ with fixed timestamps; members' declared sizes checked before reading.
 * :mod:`.tracks`: TAP-Vid-style point tracks as a pickle-free NPZ.
 * :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
@@ -28,8 +27,7 @@ from scenegen.dataset.codecs.kitti import (
                                          kitti_disparity_array,
 )
 from scenegen.dataset.codecs.kitti_flow import decode_kitti_flow_png, encode_kitti_flow_png
-from scenegen.dataset.codecs.npy import decode_npy, encode_npy, read_npy, write_npy
-from scenegen.dataset.codecs.npz import decode_npz, encode_npz
+from scenegen.dataset.codecs.npy import decode_npy, decode_npz, encode_npy, encode_npz, read_npy, read_npz, write_npy
 from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
 from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
 from scenegen.dataset.codecs.sintel import decode_cam, decode_dpt, encode_cam, encode_dpt
@@ -43,7 +41,8 @@ __all__ = [
     "decode_flo", "encode_flo", "decode_json", "encode_json", "read_json", "write_json",
     "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
     "decode_kitti_flow_png", "encode_kitti_flow_png",
-    "decode_npy", "encode_npy", "read_npy", "write_npy", "decode_npz", "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
+    "decode_npy", "decode_npz", "encode_npy", "encode_npz", "read_npy", "read_npz", "write_npy",
+    "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
     "decode_png", "encode_png", "read_png", "write_png", "decode_cam", "decode_dpt", "encode_cam", "encode_dpt",
-    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_npz", "encode_tracks", "read_tracks", "write_tracks",
+    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_tracks", "read_tracks", "write_tracks",
 ]

@@ -26,10 +26,17 @@ def encode_flo(flow) -> bytes:
 
 
 def decode_flo(data: bytes) -> np.ndarray:
-    """(H, W, 2) float32 flow with unknown values (|x| > 1e9) as NaN."""
-    magic = np.frombuffer(data, "<f4", count=1)[0]
-    if magic != np.float32(FLO_MAGIC):
-        raise ValueError(f"not a .flo file (magic {magic!r})")
+    """(H, W, 2) float32 flow with unknown values (|x| > 1e9) as NaN; ValueError saying what was
+    expected for a wrong magic, size or length."""
+    data = bytes(data)
+    if len(data) < 12:
+        raise ValueError(f"not a .flo file ({len(data)} bytes; expected a 12-byte header: magic, width, height)")
+    magic = float(np.frombuffer(data, "<f4", count=1)[0])
+    if magic != float(np.float32(FLO_MAGIC)):
+        raise ValueError(f"not a .flo file (magic {magic:g}, bytes {data[:4]!r}; expected {FLO_MAGIC}, bytes b'PIEH')")
     W, H = (int(x) for x in np.frombuffer(data, "<i4", count=2, offset=4))
+    if W < 1 or H < 1 or len(data) < 12 + 8 * W * H:  # trailing bytes are ignored, as Middlebury's reader does
+        raise ValueError(f"a .flo header of width {W} and height {H} in {len(data):,} bytes (expected sizes >= 1 "
+                         f"and 12 + 8 * W * H = {12 + 8 * W * H:,} bytes)")
     f = np.frombuffer(data, "<f4", count=H * W * 2, offset=12).reshape(H, W, 2).astype(np.float32)
     return np.where(np.abs(f) > UNKNOWN_FLOW_THRESH, np.nan, f).astype(np.float32)

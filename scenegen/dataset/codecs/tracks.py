@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.dataset.codecs.npz import decode_npz, encode_npz
+from scenegen.dataset.codecs.npy import decode_npz, encode_npz
 from scenegen.dataset.files import atomic_write_bytes, read_decoded
 
 TRACK_KEYS = ("query_points", "tracks_xy", "occluded", "out_of_frame", "image_size", "frame_names")
@@ -56,6 +56,11 @@ class TrackSet:
             if arrays[k].shape != shape or n < 0:
                 raise ValueError(f"tracks: {k} must have shape {shape} (N tracks, T frames), got "
                                  f"{arrays[k].shape}")
+        lost = ~arrays["occluded"] & ~np.all(np.isfinite(arrays["tracks_xy"]), axis=-1)
+        if lost.any():
+            i, t_ = np.argwhere(lost)[0]
+            raise ValueError(f"tracks: tracks_xy[{i}, {t_}] is not finite where the point is visible (expected finite "
+                             f"pixel coordinates wherever occluded is false; {int(lost.sum())} such entries)")
         for k, v in arrays.items():
             object.__setattr__(self, k, v)
 
@@ -69,16 +74,13 @@ def encode_tracks(tracks: TrackSet) -> bytes:
 
 
 def decode_tracks(data: bytes) -> TrackSet:
-    """Inverse of :func:`encode_tracks`; ValueError naming a missing key, a wrong shape or a
-    member that declares more than it holds (:func:`scenegen.dataset.codecs.npz.decode_npz`)."""
+    """Inverse of :func:`encode_tracks`; ValueError naming a missing key or a wrong shape (array
+    sizes checked before anything is allocated: :func:`scenegen.dataset.codecs.npy.decode_npz`)."""
     try:
-        z = decode_npz(data)
+        arrays = decode_npz(data, required=TRACK_KEYS)
     except ValueError as e:
         raise ValueError(f"tracks: {e}") from None
-    missing = [k for k in TRACK_KEYS if k not in z]
-    if missing:
-        raise ValueError(f"tracks: keys {missing} missing; have {sorted(z)}")
-    return TrackSet(**{k: z[k] for k in TRACK_KEYS})
+    return TrackSet(**{k: arrays[k] for k in TRACK_KEYS})
 
 
 def write_tracks(path, tracks: TrackSet) -> None:

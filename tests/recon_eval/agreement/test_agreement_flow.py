@@ -1,7 +1,8 @@
 """Optical-flow metrics against transcriptions of the reference code:
 
 * KITTI 2015 devkit (devkit_scene_flow): ``io_flow.h`` ``FlowImage::interpolateBackground``,
-  ``readFlowField`` / ``writeFlowField`` and ``evaluate_scene_flow.cpp`` ``flowErrorsOutlier``;
+  ``readFlowField`` / ``writeFlowField`` and ``evaluate_scene_flow.cpp`` ``flowErrorsOutlier``
+  (in its float arithmetic: exact 5 % ties on the PNG's 1/64 px grid are outliers there);
 * MPI-Sintel: EPE = mean over pixels of sqrt(du^2 + dv^2) (Butler et al. 2012, the
   ``flow_code`` error measure), the speed bins s0-10 / s10-40 / s40+;
 * Middlebury ``.flo`` (flow-code readme: "PIEH", width, height, (u, v) float32 row-major).
@@ -61,17 +62,22 @@ def _devkit_interpolate(fu, fv, valid):
 
 
 def _flow_errors_outlier(gu, gv, gvalid, eu, ev, evalid, obj):
-    """evaluate_scene_flow.cpp flowErrorsOutlier: (errors, pixels) of bg, fg, all and all_result."""
+    """evaluate_scene_flow.cpp flowErrorsOutlier: (errors, pixels) of bg, fg, all and all_result.
+    FlowImage holds floats: every value and operation below is float32 (numpy scalars), and the
+    comparisons are with the double constants ABS_THRESH and REL_THRESH (Python floats, the
+    float32 value widened first: numpy would narrow a Python float to float32 instead)."""
+    gu, gv, eu, ev = (np.asarray(a, np.float32) for a in (gu, gv, eu, ev))
     iu, iv = _devkit_interpolate(eu, ev, evalid)
     c = {k: [0, 0] for k in ("bg", "fg", "all", "all_r")}
     H, W = gvalid.shape
     for u in range(W):
         for v in range(H):
-            fu, fv = gu[v, u] - iu[v, u], gv[v, u] - iv[v, u]
-            f_dist = np.sqrt(fu * fu + fv * fv)
-            f_mag = np.sqrt(gu[v, u] ** 2 + gv[v, u] ** 2)
+            fu, fv = gu[v, u] - iu[v, u], gv[v, u] - iv[v, u]  # float fu = F_gt.getFlowU - F_ipol.getFlowU
+            f_dist = np.sqrt(fu * fu + fv * fv)  # float f_dist = sqrt(fu*fu+fv*fv)
+            f_mag = np.sqrt(gu[v, u] * gu[v, u] + gv[v, u] * gv[v, u])  # getFlowMagnitude
+            assert f_dist.dtype == f_mag.dtype == np.float32
             with np.errstate(divide="ignore", invalid="ignore"):
-                f_err = f_dist > ABS_THRESH and f_dist / f_mag > REL_THRESH
+                f_err = float(f_dist) > ABS_THRESH and float(f_dist / f_mag) > REL_THRESH
             if gvalid[v, u]:
                 key = "bg" if obj[v, u] == 0 else "fg"
                 c[key][0] += f_err
@@ -111,6 +117,36 @@ def test_fl_equals_kitti_devkit(agreement):
     agreement("kitti.fl", "Fl bg/fg/all and the est row (%), a wholly invalid interior row",
               "KITTI 2015 devkit `interpolateBackground`, `flowErrorsOutlier` (transcribed)", "devkit_scene_flow (2015)",
               "32x20, 25 % holes", d)
+
+
+def _ties(seed=0):
+    """Flows on the KITTI PNG's 1/64 px grid where a third of the pixels err by exactly 5 % of
+    the truth's magnitude, above 3 px: truth (20 k, 0) / 64, estimate (21 k, 0) / 64, or the error
+    (3 k, 4 k) / 64 on a truth of magnitude 100 k / 64."""
+    rng = np.random.default_rng(seed)
+    H, W = 24, 32
+    k = rng.integers(200, 1500, (H, W)).astype(float)
+    g = np.stack([20 * k, np.zeros((H, W))], axis=2) / 64
+    e = g + rng.integers(-400, 400, (H, W, 2)) / 64  # off the tie: mostly within 5 %, some outliers
+    tie = rng.random((H, W)) < 1 / 3
+    e[tie] = np.stack([21 * k, np.zeros((H, W))], axis=2)[tie] / 64
+    diag = tie & (rng.random((H, W)) < 0.5)
+    g[diag] = np.stack([60 * k, 80 * k], axis=2)[diag] / 64
+    e[diag] = g[diag] + np.stack([3 * k, 4 * k], axis=2)[diag] / 64
+    return g, e, tie
+
+
+def test_fl_at_exact_five_percent_ties_equals_kitti_devkit(agreement):
+    g, e, tie = _ties()
+    ones, obj = np.ones(tie.shape, bool), np.zeros(tie.shape, int)
+    c = _flow_errors_outlier(g[..., 0], g[..., 1], ones, e[..., 0], e[..., 1], ones, obj)
+    r = flow_metrics([e], [g])
+    assert c["all"][0] >= tie.sum() > 200  # every tie an outlier in the devkit
+    d = abs(r.fl_all_all_pct - 100.0 * c["all"][0] / c["all"][1])
+    assert d == 0
+    agreement("kitti.fl.ties", "Fl all (%) with exact 5 % ties (the devkit's float quotient)",
+              "KITTI 2015 devkit `flowErrorsOutlier` (transcribed, float)", "devkit_scene_flow (2015)",
+              f"32x24 on the 1/64 px grid, {int(tie.sum())} ties", d)
 
 
 def test_epe_and_sintel_bins_equal_the_definition(agreement):

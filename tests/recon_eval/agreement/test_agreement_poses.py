@@ -13,7 +13,8 @@ from evo.core import metrics as evo_metrics, sync, trajectory
 from scipy.spatial.transform import Rotation
 
 from recon_eval.metrics.align import Sim3
-from recon_eval.metrics.poses import Poses, ape, maa_deg, rpe
+from recon_eval.metrics.poses import Poses, ape, rpe
+from recon_eval.metrics.stats import maa_deg
 
 N = 60
 STATS = ("rmse", "mean", "median", "std", "min", "max")
@@ -130,23 +131,38 @@ def test_rpe_across_unregistered_frames_is_evo_after_association(delta, all_pair
               "60 poses, 5 missing from the estimate", d)
 
 
-def _imb_maa(err_deg):
+def _imb_compute_qt_auc(err_deg):
     """image-matching-benchmark utils/pack_helper.py compute_qt_auc, lines 'err_qt[err_qt == np.inf] = 1e6'
-    .. 'qt_auc_10 = np.mean(qt_acc)', transcribed."""
+    .. "res_dict['qt_auc_10{}'.format(label)] = np.mean(qt_acc)", transcribed (the errors given
+    in degrees, IMB's 'err_qt * 180.0 / np.pi' already applied): (qt_auc_05, qt_auc_10)."""
     err_qt = np.asarray(err_deg, float).copy()
-    err_qt[err_qt == np.inf] = 1e6
-    bars = np.arange(11)
-    qt_hist, _ = np.histogram(err_qt, bars)
-    qt_hist = qt_hist.astype(float) / float(len(err_qt))
-    return float(np.mean(np.cumsum(qt_hist)))
+    if len(err_qt) > 0:
+        err_qt[err_qt == np.inf] = 1e6
+        bars = np.arange(11)
+        qt_hist, _ = np.histogram(err_qt, bars)
+        num_pair = float(len(err_qt))
+        qt_hist = qt_hist.astype(float) / num_pair
+        qt_acc = np.cumsum(qt_hist)
+    else:
+        qt_acc = [0] * 10
+    return float(np.mean(qt_acc[:5])), float(np.mean(qt_acc))
 
 
 def test_maa_equals_image_matching_benchmark(agreement):
     rng = np.random.default_rng(0)
     e = np.r_[rng.uniform(0, 12, 200), np.arange(11.0), [10.0, 10.0, np.inf, 5.0]]  # exact thresholds included
-    d = abs(maa_deg(e) - _imb_maa(e))
+    auc_05, auc_10 = _imb_compute_qt_auc(e)
+    d = max(abs(maa_deg(e) - auc_10), abs(maa_deg(e, 10) - auc_10))
     assert d == 0
     assert maa_deg([10.0]) == 0.1 and maa_deg([1.0]) == 0.9  # the closed last bin, the open others
     agreement("maa10", "mAA@10 deg (errors exactly at the thresholds included)",
               "Image Matching Benchmark `compute_qt_auc` (transcribed)", "ubc-vision master",
               "215 pose errors, 15 on the bin edges", d)
+    d5 = abs(maa_deg(e, 5) - auc_05)
+    assert d5 == 0
+    assert maa_deg([5.0], 5) == 0.0 == _imb_compute_qt_auc([5.0])[0]  # 5 deg falls in [5, 6): not within 5
+    assert maa_deg([4.5], 5) == 0.2  # counted at 5 only
+    agreement("maa5", "mAA@5 deg (errors exactly at the thresholds included)",
+              "Image Matching Benchmark `compute_qt_auc` `qt_auc_05` (transcribed)", "ubc-vision master",
+              "215 pose errors, 15 on the bin edges", d5)
+    assert maa_deg([], 5) == 0.0 == _imb_compute_qt_auc([])[0]

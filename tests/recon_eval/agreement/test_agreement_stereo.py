@@ -1,7 +1,8 @@
 """Stereo metrics against transcriptions of the benchmarks' C++ (neither installs from PyPI):
 
 * KITTI 2015 devkit (devkit_scene_flow, ``io_disp.h`` ``DisparityImage::interpolateBackground``,
-  ``evaluate_scene_flow.cpp`` ``disparityErrorsOutlier``), loops transcribed line by line;
+  ``evaluate_scene_flow.cpp`` ``disparityErrorsOutlier``), loops transcribed line by line, in the
+  devkit's float arithmetic (``fabs`` of a float difference is the float overload);
 * Middlebury MiddEval3 SDK ``evaldisp.cpp`` ``evaldisp`` (clip to [0, maxdisp], rounddisp, mask
   value 255), transcribed.
 """
@@ -64,14 +65,17 @@ def _devkit_interpolate(D):
 def _devkit_errors(D_gt, D_orig, O_map):
     """evaluate_scene_flow.cpp disparityErrorsOutlier: (errors, pixels) of bg, bg_result, fg,
     fg_result, all, all_result; D_gt valid where >= 0."""
+    D_gt, D_orig = np.asarray(D_gt, np.float32), np.asarray(D_orig, np.float32)  # DisparityImage holds floats
     D_ipol = _devkit_interpolate(D_orig)
     c = {k: [0, 0] for k in ("bg", "bg_r", "fg", "fg_r", "all", "all_r")}
     H, W = D_gt.shape
     for u in range(W):
         for v in range(H):
             if D_gt[v, u] >= 0:
-                d_gt, d_est = D_gt[v, u], D_ipol[v, u]
-                d_err = abs(d_gt - d_est) > ABS_THRESH and abs(d_gt - d_est) / abs(d_gt) > REL_THRESH
+                d_gt, d_est = D_gt[v, u], D_ipol[v, u]  # float
+                diff = abs(d_gt - d_est)  # fabs(float): the float overload
+                assert diff.dtype == np.float32
+                d_err = float(diff) > ABS_THRESH and float(diff / abs(d_gt)) > REL_THRESH  # float quotient vs 0.05
                 region = "bg" if O_map[v, u] == 0 else "fg"
                 for key, use in ((region, True), (region + "_r", D_orig[v, u] >= 0), ("all", True),
                                  ("all_r", D_orig[v, u] >= 0)):
@@ -138,6 +142,22 @@ def _evaldisp(disp, gtdisp, mask, badthresh, maxdisp, rounddisp):
             else:
                 invalid += 1
     return 100.0 * bad / n, 100.0 * invalid / n, 100.0 * (bad + invalid) / n, serr / (n - invalid)
+
+
+def test_d1_at_exact_five_percent_ties_equals_kitti_devkit(agreement):
+    """Disparities on the KITTI PNG's 1/256 px grid, a third of the pixels off by exactly 5 % (> 3 px)."""
+    rng = np.random.default_rng(3)
+    k = rng.integers(16, 200, (24, 32))
+    gt = 20.0 * k / 4  # 20 k / 4 px: on the 1/256 grid
+    est = gt + rng.integers(-300, 300, gt.shape) / 256
+    tie = rng.random(gt.shape) < 1 / 3
+    est[tie] = 21.0 * k[tie] / 4  # error k / 4 px = 5 % of the truth, above 3 px for k >= 16
+    c = _devkit_errors(gt, est, np.zeros(gt.shape, int))
+    d = abs(kitti_d1([est], [gt]).d1_all_occ_pct - 100.0 * c["all"][0] / c["all"][1])
+    assert c["all"][0] >= tie.sum() > 200 and d == 0
+    agreement("kitti.d1.ties", "D1 all (%) with exact 5 % ties (the devkit's float quotient)",
+              "KITTI 2015 devkit `disparityErrorsOutlier` (transcribed, float)", "devkit_scene_flow (2015)",
+              f"32x24 on the 1/256 px grid, {int(tie.sum())} ties", d)
 
 
 def _middlebury_input(seed=1):

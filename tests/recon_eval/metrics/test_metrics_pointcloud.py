@@ -90,12 +90,21 @@ class TestEth3d:
         assert (below.accuracy, below.completeness, below.f1) == (0.0, 0.0, 0.0)
 
     def test_per_voxel_averaging_cancels_density(self):
-        gt = np.array([[0.5, 0.5, 0.5]])
+        gt = np.array([[0.25, 0.25, 0.25]])  # in one cell of either grid (shifted by 0 and 0.5 voxel)
         dense_good = gt + np.random.default_rng(0).uniform(-0.01, 0.01, size=(100, 3))
-        bad = np.array([[5.5, 0.5, 0.5]])
+        bad = np.array([[5.25, 0.25, 0.25]])
         r = eth3d(np.r_[dense_good, bad], gt, 0.05, voxel_m=1.0)
-        assert r.accuracy == pytest.approx(0.5)  # (1 + 0) / 2 voxels, not 100 / 101 points
+        assert r.accuracy == 0.5  # (1 + 0 + 1 + 0) / 4 cells of the two grids, not 100 / 101 points
         assert r.completeness == 1.0
+
+    def test_the_two_grids_are_pooled(self):
+        """ETH3D's kGridShifts: a cell boundary of one grid is a cell centre of the other. Points at
+        x = 0.1, 0.4 (good) and 0.6 (bad), voxel 1: one cell [0, 1) of the unshifted grid (2/3
+        good); x + 0.5 = 0.6, 0.9 and 1.1 fill two cells of the shifted grid (1 and 0). The mean
+        over the three cells, 0.556, not the one grid's 0.667; cell fractions in float as ETH3D."""
+        gt = np.array([[0.1, 0.25, 0.25], [0.4, 0.25, 0.25]])
+        r = eth3d(np.r_[gt, [[0.6, 0.25, 0.25]]], gt, 0.1, voxel_m=1.0)
+        assert r.accuracy == np.float32((float(np.float32(2) / np.float32(3)) + 1.0 + 0.0) / 3)
 
     def test_unobserved_points_are_excluded_and_counted(self):
         gt = lattice()

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from recon_eval.metrics.poses import maa_deg
-from recon_eval.metrics.stats import error_stats, recall_auc
+from recon_eval.errors import InputError
+from recon_eval.metrics.stats import error_stats, maa_deg, recall_auc
 
 
 class TestRecallAuc:
@@ -42,6 +42,14 @@ class TestRecallAuc:
 def test_maa_hand_computed():
     # th = 1: only 0.5 < 1 (1.0 is not < 1); th = 2..5: 2/4; th = 6..10: 3/4
     assert maa_deg([0.5, 1.0, 5.5, np.inf]) == pytest.approx((0.25 + 4 * 0.5 + 5 * 0.75) / 10, abs=1e-15)
+    # mAA@5 takes the first 5 bins of the 10: an error of exactly 5 is in [5, 6), counted from th = 6
+    assert maa_deg([0.5, 1.0, 5.0, np.inf], 5) == pytest.approx((0.25 + 4 * 0.5) / 5, abs=1e-15)
+
+
+@pytest.mark.parametrize("bad", [0, 11, 2.5, -1])
+def test_maa_thresholds_are_those_of_the_benchmarks_histogram(bad):
+    with pytest.raises(InputError, match="expected an integer 1 .. 10"):
+        maa_deg([1.0], bad)
 
 
 def test_error_stats_reports_failures():

@@ -26,12 +26,15 @@ class TestKittiD1:
         assert r.density_pct == pytest.approx(80.0)
         assert (r.n_px_occ, r.n_px_noc) == (5, 4)
 
-    def test_both_conditions_are_strict(self):
+    def test_both_conditions_are_strict_in_the_devkits_float_arithmetic(self):
         gt = np.array([[60.0, 100.0]])
         est = np.array([[63.0, 105.0]])  # 3 px exactly (5 %); 5 px at exactly 5 %
-        assert kitti_d1([est], [gt]).d1_all_occ_pct == 0.0
-        est2 = np.array([[63.0 + 1e-9, 105.0 + 1e-9]])
+        # 3 > 3 is false; the float quotient 5 / 100 = 0.0500000007 > 0.05: the devkit's outlier
+        assert kitti_d1([est], [gt]).d1_all_occ_pct == 50.0
+        est2 = np.array([[np.nextafter(np.float32(63), np.float32(64)), 105.0]])  # one float above 3 px
         assert kitti_d1([est2], [gt]).d1_all_occ_pct == 100.0
+        est3 = np.array([[63.0, np.nextafter(np.float32(105), np.float32(0))]])  # one float below 5 px
+        assert kitti_d1([est3], [gt]).d1_all_occ_pct == 0.0
 
     def test_pooled_over_images_not_averaged(self):
         gt1, est1 = np.full((1, 1), 10.0), np.full((1, 1), 20.0)  # 1 of 1 bad
