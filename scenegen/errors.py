@@ -10,6 +10,11 @@ import errno
 from dataclasses import dataclass
 
 
+#: The file name of a spec built in Python (scenegen.api): its YAML is generated, so a place in
+#: it is named by its field only, never by a line of that YAML.
+PYTHON_FILE = "<python>"
+
+
 @dataclass(frozen=True)
 class Where:
     """A place in a spec file: ``file`` as given by the user, ``line`` 1-based (or None),
@@ -41,9 +46,9 @@ class SpecError(Exception):
 
     @classmethod
     def at(cls, where: Where | None, message: str) -> "SpecError":
-        """An error at a recorded place (``where`` may be None)."""
+        """An error at a recorded place (``where`` may be None; no line in a spec built in Python)."""
         w = where or Where()
-        return cls(message, file=w.file, line=w.line, field=w.field)
+        return cls(message, file=w.file, line=None if w.file == PYTHON_FILE else w.line, field=w.field)
 
     @property
     def where(self) -> Where:
