@@ -179,7 +179,7 @@ def cmd_examples(args) -> int:
 
     if args.copy is not None:
         n = copy_examples(args.copy)
-        print(f"copied {n} files into {args.copy} (scenes/, gates/)")
+        print(f"copied {n} files into {args.copy} (scenes/, gates/, examples/, baselines/)")
         return 0
     for kind, path in example_files():
         print(f"{kind}\t{path}")
