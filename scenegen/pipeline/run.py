@@ -162,6 +162,8 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
                     rendered += 1
                     bar.advance()
     run_crossview(spec, views, built, writer, spp=spp, seed=seed, progress=progress)  # docs/crossview.md
-    run_sequence(spec, views, built, writer)  # truth across time of a sequence (docs/crossview.md)
+    with ViewProgress(progress and spec.sequence is not None, 1, label="sequence truth", unit="stages") as bar:
+        run_sequence(spec, views, built, writer)  # truth across time of a sequence (docs/crossview.md)
+        bar.advance()
     writer.close()
     return rendered, todo, skipped
