@@ -129,6 +129,15 @@ def cmd_info(args) -> int:
     return 0
 
 
+def _summary_text(v) -> str:
+    """A summary value as words, not Python's repr: ``a: x; b: y`` for a mapping, ``a, b`` for a list."""
+    if isinstance(v, dict):
+        return "; ".join(f"{k}: {_summary_text(x)}" for k, x in v.items())
+    if isinstance(v, (list, tuple)):
+        return ", ".join(map(str, v))
+    return str(v)
+
+
 def cmd_export(args) -> int:
     from scenegen.export import PROGRESS_UNITS, export  # the command's implementation, on use
     from scenegen.pipeline.progress import line_progress  # the command's implementation, on use
@@ -136,7 +145,7 @@ def cmd_export(args) -> int:
     s = export(args.dataset, args.format, args.output,
                progress=line_progress(f"export {args.format}", PROGRESS_UNITS[args.format],
                                       enabled=args.verbosity > QUIET))
-    extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
+    extra = ", ".join(f"{k} {_summary_text(v)}" for k, v in s.items() if k not in ("dest", "files"))
     print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
     return 0
 
