@@ -3,6 +3,7 @@ the documented block runs as written on an OBJ/MTL/PNG and a Y-up glTF, and the 
 are the textures'; meshes given as paths, hand-built mesh records, materials, light names and
 warnings that name fields."""
 import dataclasses
+import json
 import re
 from pathlib import Path
 
@@ -13,6 +14,7 @@ import trimesh
 from PIL import Image
 
 from scenegen import api
+from scenegen.cli import main
 from scenegen.dataset import Dataset
 from scenegen.errors import SpecError
 from scenegen.geometry.color import linear_from_srgb
@@ -46,7 +48,7 @@ def documented_block() -> str:
 
 
 @pytest.mark.render
-def test_the_documented_stereo_sequence_with_own_obj_and_gltf_renders_their_textures(tmp_path, monkeypatch):
+def test_the_documented_stereo_sequence_with_own_obj_and_gltf_renders_their_textures(tmp_path, monkeypatch, capsys):
     write_assets(tmp_path)
     monkeypatch.chdir(tmp_path)
     ns: dict = {}
@@ -73,6 +75,16 @@ def test_the_documented_stereo_sequence_with_own_obj_and_gltf_renders_their_text
     assert max(crate_err) < 0.05, crate_err  # measured 0.032 at 4 spp
     for a, b, resid in lamp_fit:
         assert 0.95 < a < 1.15 and 0.0 <= b < 0.03 and resid < 0.006, (a, b, resid)
+    # `scenegen info` names the scene, its clock and the truth it holds
+    capsys.readouterr()
+    assert main(["info", "out/my_assets", "--limit", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "scene 'my_assets'" in out and "sequence: 3 frames at 10 fps, t = 0 .. 0.2 s; flow steps 1" in out
+    assert "truth per view: depth_z, instance_id, normals_cam" in out and "sequence truth: flow, motion, object poses" in out
+    assert main(["info", "out/my_assets", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["scene"] == "my_assets" and doc["sequence"]["timestamps_s"] == [0.0, 0.1, 0.2]
+    assert "object_id" in doc["truth"]["view"] and doc["truth"]["sequence"] == ["flow", "motion", "object poses"]
     # the glTF's floor (its xz plane, +Y up) is our z = 0 plane; frame 0 places it at x + 0.2
     v = ds.mesh("lamp").vertices
     np.testing.assert_allclose(v[:, 2], 0.0, atol=1e-7)
