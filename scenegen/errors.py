@@ -25,7 +25,8 @@ class Where:
     field: str | None = None
 
     def __str__(self) -> str:
-        head = ":".join(str(p) for p in (self.file, self.line) if p is not None)
+        line = None if self.file == PYTHON_FILE else self.line  # a line of generated YAML means nothing
+        head = ":".join(str(p) for p in (self.file, line) if p is not None)
         return ": ".join(p for p in (head, self.field or "") if p)
 
 
@@ -46,9 +47,9 @@ class SpecError(Exception):
 
     @classmethod
     def at(cls, where: Where | None, message: str) -> "SpecError":
-        """An error at a recorded place (``where`` may be None; no line in a spec built in Python)."""
+        """An error at a recorded place (``where`` may be None)."""
         w = where or Where()
-        return cls(message, file=w.file, line=None if w.file == PYTHON_FILE else w.line, field=w.field)
+        return cls(message, file=w.file, line=w.line, field=w.field)
 
     @property
     def where(self) -> Where:
