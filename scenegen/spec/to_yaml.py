@@ -164,7 +164,7 @@ def _sequence(q: m.SequenceSpec) -> dict:
 
 
 def _light(li) -> dict:
-    d: dict[str, Any] = {"name": li.name, "type": li.type}
+    d: dict[str, Any] = {"name": li.name, "type": li.type} if li.name is not None else {"type": li.type}
     if isinstance(li, m.PointLight):
         d.update(position=_v(li.position), intensity=_v(li.intensity))
     elif isinstance(li, m.ConstantLight):
