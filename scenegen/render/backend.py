@@ -97,11 +97,12 @@ def resolve_variant(requested: str = "auto") -> str:
         if llvm_available():
             return "llvm_ad_rgb"
         warnings.warn(
-            "no working libLLVM >= 16 found (install Debian's libllvm19 or set DRJIT_LIBLLVM_PATH); "
+            "no working libLLVM >= 16 found (install one of Debian's/Ubuntu's libllvm16..21, e.g. 'make llvm', "
+            "or set DRJIT_LIBLLVM_PATH); "
             "falling back to scalar_rgb, which is 40-60x slower", RuntimeWarning, stacklevel=2)
         return "scalar_rgb"
     if requested == "llvm_ad_rgb" and not llvm_available():
-        raise BackendError("llvm_ad_rgb needs libLLVM >= 16 (Debian: apt-get install libllvm19, or set "
+        raise BackendError("llvm_ad_rgb needs libLLVM >= 16 (Debian/Ubuntu: apt-get install libllvm19, or 16..21; or set "
                            "DRJIT_LIBLLVM_PATH); libLLVM 15 aborts the process and is never used")
     if requested == "cuda_ad_rgb" and not cuda_available():
         raise BackendError("cuda_ad_rgb needs an NVIDIA GPU with a working CUDA driver")
