@@ -177,11 +177,13 @@ def _resolved_paths(x, base: Path, field: str):
         if not f.init or f.name == "where":
             continue
         v = getattr(x, f.name)
-        if f.name == "path" and getattr(x, "path_as_written", None):
-            v = (base / Path(x.path_as_written).expanduser()).resolve()
+        if f.name == "path" and v is not None and hasattr(x, "path_as_written"):
+            written = x.path_as_written or str(v)  # a dataclass given only its path
+            v = (base / Path(written).expanduser()).resolve()
             if not v.is_file():
-                raise SpecError(f"file not found: {x.path_as_written!r} (looked for {v})", file=PYTHON_FILE,
-                                field=field)
+                raise SpecError(f"file not found: {written!r} (looked for {v})", file=PYTHON_FILE, field=field)
+            if not x.path_as_written:
+                changes["path_as_written"] = written
         elif dataclasses.is_dataclass(v) or isinstance(v, (tuple, list)):
             v = _resolved_paths(v, base, f"{field}.{f.name}")
         if v is not getattr(x, f.name):

@@ -119,6 +119,9 @@ def test_image_textures_resolve_against_base_dir_and_a_missing_file_names_its_fi
     mat = api.DiffuseMaterial(texture=api.image_texture("assets/crate.png"))
     spec = api.Scene(objects=[api.obj("ball", api.Sphere(radius=0.2), material=mat)], base_dir=tmp_path)
     assert spec.objects[0].material.texture.path == (tmp_path / "assets/crate.png").resolve()
+    bare = api.DiffuseMaterial(texture=api.Texture(kind="image", path=Path("assets/crate.png")))  # no path_as_written
+    spec = api.Scene(objects=[api.obj("ball", api.Sphere(radius=0.2), material=bare)], base_dir=tmp_path)
+    assert spec.objects[0].material.texture.path == (tmp_path / "assets/crate.png").resolve()
     with pytest.raises(SpecError, match=r"^<python>: objects\[0\]\.mesh: file not found: 'nope.obj'"):
         api.Scene(objects=[api.obj("x", "nope.obj")], base_dir=tmp_path)
 
