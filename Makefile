@@ -7,14 +7,27 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 .PHONY: setup llvm bench-deps demo test bench clean
 
 # Dr.Jit's LLVM back end needs libLLVM >= 16 (Debian's 15 aborts the process; see
-# docs/conventions.md). Without apt the renderer falls back to scalar_rgb with a warning.
+# docs/conventions.md). Debian and Ubuntu name libLLVM N's package libllvmN: any of these that is
+# installed will do, else the first apt can install (19 first: the one measured here). Never an
+# error: without one the renderer falls back to the slow scalar_rgb with a warning.
+LLVM_PACKAGES ?= libllvm19 libllvm20 libllvm21 libllvm18 libllvm17 libllvm16
 llvm:
-	@if command -v dpkg >/dev/null && dpkg -s libllvm19 >/dev/null 2>&1; then :; \
-	elif command -v apt-get >/dev/null; then \
-	  echo "installing libllvm19 (Debian) for Dr.Jit's LLVM back end"; \
-	  $(SUDO) apt-get install -y -qq libllvm19 >/dev/null 2>&1 || \
-	  { $(SUDO) apt-get update -qq >/dev/null && $(SUDO) apt-get install -y -qq libllvm19 >/dev/null; }; \
-	else echo "no apt-get: install libLLVM >= 16 yourself or expect the slow scalar_rgb fallback"; fi
+	@for p in $(LLVM_PACKAGES); do \
+	  if command -v dpkg >/dev/null 2>&1 && dpkg -s $$p >/dev/null 2>&1; then exit 0; fi; \
+	done; \
+	if ! command -v apt-get >/dev/null 2>&1; then \
+	  echo "warning: no apt-get: install libLLVM >= 16 yourself (or set DRJIT_LIBLLVM_PATH), else the renderer falls back to the slow scalar_rgb" >&2; \
+	  exit 0; \
+	fi; \
+	for update in no yes; do \
+	  [ $$update = yes ] && { $(SUDO) apt-get update -qq >/dev/null 2>&1 || true; }; \
+	  for p in $(LLVM_PACKAGES); do \
+	    if $(SUDO) apt-get install -y -qq $$p >/dev/null 2>&1; then \
+	      echo "installed $$p for Dr.Jit's LLVM back end"; exit 0; \
+	    fi; \
+	  done; \
+	done; \
+	echo "warning: apt-get could install none of $(LLVM_PACKAGES): install libLLVM >= 16 yourself (or set DRJIT_LIBLLVM_PATH), else the renderer falls back to the slow scalar_rgb" >&2
 
 $(VENV)/.installed: pyproject.toml
 	$(PY) -m venv $(VENV)

@@ -20,11 +20,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from os import PathLike
 from pathlib import Path
 from typing import Iterable, Mapping
 
+from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
 from scenegen.errors import SpecError
-from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.conventions import mesh_up_axis
+from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.geometry.rotation import rotation_from_euler_deg
 from scenegen.pipeline.run import RenderSummary, render_spec
 from scenegen.spec import check_spec, same_spec, to_yaml
@@ -35,12 +38,22 @@ from scenegen.spec.model import (  # re-exported: the building blocks
     RenderSettings, Rig, RigMember, SceneObject, SceneSpec, Sphere, SpotLight, Texture, Torus,
     Transform, ViewSet,
 )
+from scenegen.spec.model.geometry import AssetFile, Mesh
+from scenegen.spec.model.materials import PrincipledMaterial
 from scenegen.spec.model.meta import frozen_mapping
+from scenegen.spec.model.timeline import Animation, JointSpec, Keyframe, SequenceSpec, TrackSpec, TrajectorySpec
+from scenegen.spec.model.views import TrajectoryPath
+from scenegen.spec.parse.lights import default_light_name
+from scenegen.spec.parse.rigs import stereo_rig
+from scenegen.spec.parse.timeline import start_transform
 from scenegen.spec.source import SpecSource
 from scenegen.spec.to_yaml import PYTHON_FILE
 
 __all__ = [
     "Scene", "camera", "obj", "render", "to_yaml", "check_spec", "same_spec", "SpecError",
+    "mesh", "image_texture", "sequence", "keyframe", "trajectory", "stereo_rig",
+    "Animation", "JointSpec", "Keyframe", "Mesh", "PrincipledMaterial", "SequenceSpec", "TrackSpec",
+    "TrajectoryPath", "TrajectorySpec",
     "AreaLight", "ArucoGridTarget", "Blob", "Box", "CameraSpec", "CharucoTarget", "CheckerboardTarget",
     "CirclePath", "ConductorMaterial", "ConstantLight", "CrossviewSpec", "Cylinder", "DiffuseMaterial",
     "EnvmapLight", "LinePath", "LookAt", "LookAtList", "MatchSetSpec", "Orbit", "Plane", "PlasticMaterial",
@@ -49,17 +62,79 @@ __all__ = [
 ]
 
 
+def mesh(path, *, up_axis: str | None = None) -> Mesh:
+    """A mesh file (.ply, .obj, .glb, .gltf, .stl) as an object's geometry, with its own materials
+    (OBJ/MTL, glTF PBR, vertex colours) unless :func:`obj` is given a ``material``. A relative
+    ``path`` resolves against ``Scene(base_dir=...)``. ``up_axis``: 'y' or 'z'; None = the
+    format's (glTF is Y-up by its specification, turned into our Z-up frame; others Z-up)."""
+    written = str(path)
+    return Mesh(path=Path(written), path_as_written=written,
+                up_axis=mesh_up_axis(Path(written).suffix) if up_axis is None else up_axis)
+
+
+def image_texture(path) -> Texture:
+    """An image file as a material's texture (``DiffuseMaterial(texture=...)``); a relative path
+    resolves against ``Scene(base_dir=...)``."""
+    return Texture(kind="image", path=Path(str(path)), path_as_written=str(path))
+
+
+def keyframe(time_s: float, *, translation=(0.0, 0.0, 0.0), rotation_deg=(0.0, 0.0, 0.0), order: str = "xyz",
+             eye=None, target=None, up=(0.0, 0.0, 1.0)) -> Keyframe:
+    """A pose at ``time_s`` on the sequence clock: translation + Euler rotation (an object's
+    world_from_object, or a camera's / rig's world_from_cam), or a camera looking from ``eye`` at
+    ``target`` (OpenCV axes, ``up`` the world direction up the image)."""
+    if eye is not None:
+        if target is None:
+            raise SpecError("a look-at keyframe needs both eye and target", file=PYTHON_FILE, field="keyframe")
+        return Keyframe(time_s=float(time_s), pose=look_at(eye, target, up))
+    return Keyframe(time_s=float(time_s), pose=Rigid3(rotation_from_euler_deg(rotation_deg, order), translation))
+
+
+def trajectory(keyframes: Iterable[Keyframe], interpolation: str = "spline") -> TrajectorySpec:
+    """Keyframes (strictly increasing times) interpolated 'linear' or 'spline' (C2)."""
+    return TrajectorySpec(interpolation=interpolation, keyframes=tuple(keyframes))
+
+
+def sequence(*, fps: float | None = None, frames: int | None = None, start_s: float = 0.0, timestamps_s=None,
+             flow_steps=(1,), tracks: TrackSpec | None = None) -> SequenceSpec:
+    """The clock of a sequence (``Scene(sequence=...)``): ``fps`` and ``frames`` (frame k at
+    start_s + k / fps), or explicit ``timestamps_s``; flow truth for frame steps ``flow_steps``."""
+    if timestamps_s is None:
+        if fps is None or frames is None:
+            raise SpecError("give fps and frames, or timestamps_s", file=PYTHON_FILE, field="sequence")
+        times = tuple(start_s + k / fps for k in range(int(frames)))  # the parser's formula
+    else:
+        fps = frames = None
+        times = tuple(float(t) for t in timestamps_s)
+    return SequenceSpec(fps=fps, frames=frames, start_s=start_s, timestamps_s=times,
+                        flow_steps=tuple(flow_steps), tracks=tracks)
+
+
 def obj(name: str, geometry, *, material=None, translation=(0.0, 0.0, 0.0), rotation_deg=(0.0, 0.0, 0.0),
-        order: str = "xyz", scale=1.0, instance_id: int | None = None, motion=None) -> SceneObject:
+        order: str = "xyz", scale=1.0, instance_id: int | None = None, motion=None, trajectory=None,
+        parent: str | None = None, joint: JointSpec | None = None, visible_s=None) -> SceneObject:
     """A :class:`SceneObject` placed as a YAML ``transform`` (translation, rotation_deg with its
-    Euler ``order``, scale: one number or three); ``material`` a material or the name of one in
-    ``Scene(materials=...)``; None = the default grey diffuse. Its object_id is set by
+    Euler ``order``, scale: one number or three). ``geometry``: a shape, a target, :func:`mesh`
+    or a mesh file's path. ``material``: a material or the name of one in
+    ``Scene(materials=...)``; None = a mesh file's own materials, else grey diffuse. In a
+    sequence: ``trajectory`` (keyframes of world_from_object, or parent_from_object with a
+    ``parent``), ``joint``, ``visible_s``; with a joint or a parent and no trajectory the
+    translation/rotation is the rest pose in the parent frame. Its object_id is set by
     :func:`Scene` (its position in ``objects``); ``instance_id`` defaults to it."""
+    if isinstance(geometry, (str, PathLike)):
+        geometry = mesh(geometry)
     scale3 = tuple(float(s) for s in (scale if isinstance(scale, (tuple, list)) else (scale,) * 3))
     pose = Rigid3(rotation_from_euler_deg(rotation_deg, order), translation)
+    if isinstance(geometry, Mesh):  # the file's own materials unless one is given (Scene checks it has any)
+        geometry = dataclasses.replace(geometry, own_materials=material is None)
+    animation = None
+    if trajectory is not None or parent is not None or joint is not None or visible_s is not None:
+        animation = Animation(parent=parent, trajectory=trajectory, joint=joint, rest=pose,
+                              visible_s=None if visible_s is None else tuple(float(t) for t in visible_s))
     return SceneObject(name=name, geometry=geometry, transform=Transform(world_from_object=pose, scale=scale3),
                        material=material if material is not None else DiffuseMaterial(), object_id=0,
-                       instance_id=0 if instance_id is None else instance_id, motion=motion)
+                       instance_id=0 if instance_id is None else instance_id, motion=motion,
+                       animation=animation)
 
 
 def camera(name: str, *, size, fx: float | None = None, fy: float | None = None, cx: float | None = None,
@@ -89,16 +164,70 @@ def _named(things, what: str) -> dict:
     return out
 
 
+def _resolved_paths(x, base: Path, field: str):
+    """``x`` with every file it names (a mesh, a texture, an environment map) resolved against
+    ``base`` as the parser resolves a spec's paths; a mesh also gets the files it names and
+    whether its own materials are rendered (``own_materials`` asked for and the file has some)."""
+    if isinstance(x, (tuple, list)):
+        return type(x)(_resolved_paths(v, base, f"{field}[{i}]") for i, v in enumerate(x))
+    if not dataclasses.is_dataclass(x) or isinstance(x, type):
+        return x
+    changes = {}
+    for f in dataclasses.fields(x):
+        if not f.init or f.name == "where":
+            continue
+        v = getattr(x, f.name)
+        if f.name == "path" and v is not None and hasattr(x, "path_as_written"):
+            written = x.path_as_written or str(v)  # a dataclass given only its path
+            v = (base / Path(written).expanduser()).resolve()
+            if not v.is_file():
+                raise SpecError(f"file not found: {written!r} (looked for {v})", file=PYTHON_FILE, field=field)
+            if not x.path_as_written:
+                changes["path_as_written"] = written
+        elif dataclasses.is_dataclass(v) or isinstance(v, (tuple, list)):
+            v = _resolved_paths(v, base, f"{field}.{f.name}")
+        if v is not getattr(x, f.name):
+            changes[f.name] = v
+    if getattr(x, "texture", None) is not None and getattr(x, "color", None) is not None:
+        changes["color"] = None  # a texture replaces the colour (the YAML gives one of the two)
+    out = dataclasses.replace(x, **changes) if changes else x
+    if isinstance(out, Mesh):
+        try:
+            scan = scan_mesh_file(out.path)
+        except AssetFileError as e:
+            raise SpecError(f"{e.message} (the mesh of {PYTHON_FILE}: {field})", file=str(e.file), line=e.line) \
+                from None
+        out = dataclasses.replace(out, own_materials=out.own_materials and scan.has_materials,
+                                  files=tuple(AssetFile(path=r.path, path_as_written=r.written) for r in scan.refs))
+    return out
+
+
+def _views_on_clock(views, seq: SequenceSpec | None) -> tuple:
+    """View sets whose trajectory placement has no times yet get the sequence's timestamps."""
+    out = []
+    for vs in views:
+        p = vs.placement
+        if isinstance(p, TrajectorySpec):
+            p = TrajectoryPath(trajectory=p, times_s=())
+        if isinstance(p, TrajectoryPath) and not p.times_s and seq is not None:
+            p = TrajectoryPath(trajectory=p.trajectory, times_s=seq.timestamps_s)
+        out.append(vs if p is vs.placement else dataclasses.replace(vs, placement=p))
+    return tuple(out)
+
+
 def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: Iterable = (),
           cameras: Iterable[CameraSpec] | Mapping[str, CameraSpec] = (), rigs: Iterable[Rig] | Mapping = (),
           views: Iterable[ViewSet] = (), materials: Mapping = frozen_mapping(), render: RenderSettings | None = None,
           crossview: CrossviewSpec | None = None, variation=None, seed: int = 0, description: str = "",
-          base_dir=None) -> SceneSpec:
+          base_dir=None, sequence: SequenceSpec | None = None) -> SceneSpec:
     """A validated :class:`SceneSpec` (what ``load_spec`` gives for the same YAML, warnings
     included). Object ids are the objects' positions (1-based); a material given by name is
     looked up in ``materials``; ``base_dir`` is where relative mesh and image paths resolve
-    (default: the current directory). SpecError naming the field on a bad value."""
-    mats = _named(materials, "material")
+    (default: the current directory); ``sequence`` (:func:`sequence`) makes it a sequence: an
+    animated object's pose at frame 0 and a trajectory placement's times come from it.
+    SpecError naming the field on a bad value."""
+    base = Path(base_dir).resolve() if base_dir is not None else Path.cwd()
+    mats = {k: _resolved_paths(v, base, f"materials.{k}") for k, v in _named(materials, "material").items()}
     objs = []
     for i, o in enumerate(objects):
         mat = o.material
@@ -107,13 +236,20 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
                 raise SpecError(f"undefined material {mat!r}; defined: {', '.join(mats) or 'none'}",
                                 file=PYTHON_FILE, field=f"objects[{i}].material")
             mat = mats[mat]
-        objs.append(dataclasses.replace(o, object_id=i + 1, instance_id=o.instance_id or i + 1, material=mat))
+        else:
+            mat = _resolved_paths(mat, base, f"objects[{i}].material")
+        o = dataclasses.replace(o, object_id=i + 1, instance_id=o.instance_id or i + 1, material=mat,
+                                geometry=_resolved_paths(o.geometry, base, f"objects[{i}].mesh"))
+        if o.animation is not None and sequence is not None:
+            o = dataclasses.replace(o, transform=start_transform(o.animation, o.transform.scale, objs, sequence))
+        objs.append(o)
     spec = SceneSpec(name=name, description=description, seed=seed, render=render or RenderSettings(),
-                     materials=frozen_mapping(mats), objects=tuple(objs), lights=tuple(lights),
+                     materials=frozen_mapping(mats), objects=tuple(objs),
+                     lights=tuple(_resolved_paths(li if li.name is not None else dataclasses.replace(
+                         li, name=default_light_name(i)), base, f"lights[{i}]") for i, li in enumerate(lights)),
                      cameras=frozen_mapping(_named(cameras, "camera")), rigs=frozen_mapping(_named(rigs, "rig")),
-                     view_sets=tuple(views), file=PYTHON_FILE,
-                     base_dir=Path(base_dir).resolve() if base_dir is not None else Path.cwd(),
-                     crossview=crossview, variation=variation)
+                     view_sets=_views_on_clock(views, sequence), file=PYTHON_FILE, base_dir=base,
+                     crossview=crossview, variation=variation, sequence=sequence)
     return check_spec(spec)
 
 

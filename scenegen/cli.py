@@ -46,6 +46,7 @@ class _Parser(argparse.ArgumentParser):
 
 def cmd_validate(args) -> int:
     from scenegen.spec import load_spec, resolve_views  # the command's implementation, on use
+    from scenegen.spec.model import effective_spp  # the command's implementation, on use
 
     spec = load_spec(args.spec)
     views = resolve_views(spec)
@@ -58,8 +59,11 @@ def cmd_validate(args) -> int:
     if args.verbosity > QUIET:
         for w in spec.warnings:
             print(f"warning: {w}", file=sys.stderr)
+    rs = spec.render
+    n = effective_spp(rs.sampler, rs.spp)
     print(f"{args.spec}: OK: {len(spec.objects)} objects, {len(spec.lights)} lights, "
-          f"{len(spec.cameras)} cameras, {len(views)} views")
+          f"{len(spec.cameras)} cameras, {len(views)} views, spp {rs.spp}"
+          + (f" (the {rs.sampler} takes {n})" if n != rs.spp else ""))
     return 0
 
 
@@ -93,6 +97,25 @@ def _print_summary(s) -> None:
     print(f"  images: {s.out_dir / 'images'}   truth: {s.out_dir / 'truth'}   cameras: {s.out_dir / 'cameras.json'}")
 
 
+def _truth_kinds(d) -> dict:
+    """Which truth the dataset holds: the per-view maps (of its first view), and the kinds of the
+    cross-view and sequence stages (their folders; a sequence's per-object poses)."""
+    def under(top: str) -> list[str]:
+        kinds = {p.split("/")[1] for p in d.manifest["files"] if p.startswith(top + "/") and p.count("/") > 1}
+        if top == "sequence" and "sequence/objects.json" in d.manifest["files"]:
+            kinds.add("object poses")
+        return sorted(kinds)
+    return {"view": sorted(d.truth(d.views[0])) if d.views else [], "crossview": under("crossview"),
+            "sequence": under("sequence")}
+
+
+def _sequence_text(q: dict) -> str:
+    t = q["timestamps_s"]
+    clock = f"{q['frames']} frames at {q['fps']:g} fps" if q.get("fps") else f"{len(t)} frames"
+    return (f"{clock}, t = {t[0]:g} .. {t[-1]:g} s; flow steps {', '.join(map(str, q['flow_steps']))}"
+            + (f"; {q['tracks']['count']} point tracks" if q.get("tracks") else ""))
+
+
 def info_document(d) -> dict:
     """What ``info --json`` prints: the manifest's identity and every complete view's camera."""
     m = d.manifest
@@ -103,9 +126,10 @@ def info_document(d) -> dict:
         views[v] = {"camera_name": info.get("camera_name"), "rig": info.get("rig"),
                     "frame_index": info.get("frame_index"), "camera": cam.to_dict(),
                     "cam_from_world": pose.to_dict(), "centre_m": pose.inverse().t.tolist()}
-    return {"dataset": str(d.root), "format": m["format"], "format_version": m["format_version"],
+    return {"dataset": str(d.root), "scene": d.scene_name, "format": m["format"], "format_version": m["format_version"],
             "variant": m["variant"], "seed": m["seed"], "views_complete": len(d.views),
             "views_total": len(d.all_views), "files": len(m["files"]),
+            "sequence": (d.spec or {}).get("sequence"), "truth": _truth_kinds(d),
             "crossview": d.crossview.index is not None, "views": views}
 
 
@@ -117,8 +141,16 @@ def cmd_info(args) -> int:
         print(json.dumps(info_document(d), indent=2))
         return 0
     m = d.manifest
-    print(f"{args.dataset}: {m['format']} v{m['format_version']}, variant {m['variant']}, seed {m['seed']}")
+    print(f"{args.dataset}: scene {d.scene_name!r}, {m['format']} v{m['format_version']}, variant {m['variant']}, "
+          f"seed {m['seed']}")
     print(f"  views: {len(d.views)} complete of {len(d.all_views)}; files: {len(m['files'])}")
+    if (q := (d.spec or {}).get("sequence")) is not None:
+        print(f"  sequence: {_sequence_text(q)}")
+    kinds = _truth_kinds(d)
+    print(f"  truth per view: {', '.join(kinds['view']) or 'none'}")
+    print(f"  cross-view truth: {', '.join(kinds['crossview']) or 'none'}")
+    if kinds["sequence"]:
+        print(f"  sequence truth: {', '.join(kinds['sequence'])}")
     for v in d.views[: args.limit]:
         cam, pose = d.camera(v)
         c = pose.inverse().t
@@ -129,6 +161,15 @@ def cmd_info(args) -> int:
     return 0
 
 
+def _summary_text(v) -> str:
+    """A summary value as words, not Python's repr: ``a: x; b: y`` for a mapping, ``a, b`` for a list."""
+    if isinstance(v, dict):
+        return "; ".join(f"{k}: {_summary_text(x)}" for k, x in v.items())
+    if isinstance(v, (list, tuple)):
+        return ", ".join(map(str, v))
+    return str(v)
+
+
 def cmd_export(args) -> int:
     from scenegen.export import PROGRESS_UNITS, export  # the command's implementation, on use
     from scenegen.pipeline.progress import line_progress  # the command's implementation, on use
@@ -136,7 +177,7 @@ def cmd_export(args) -> int:
     s = export(args.dataset, args.format, args.output,
                progress=line_progress(f"export {args.format}", PROGRESS_UNITS[args.format],
                                       enabled=args.verbosity > QUIET))
-    extra = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("dest", "files"))
+    extra = ", ".join(f"{k} {_summary_text(v)}" for k, v in s.items() if k not in ("dest", "files"))
     print(f"exported {args.dataset} as {args.format} to {s['dest']}: {s['files']} files" + (f" ({extra})" if extra else ""))
     return 0
 
@@ -179,7 +220,7 @@ def cmd_examples(args) -> int:
 
     if args.copy is not None:
         n = copy_examples(args.copy)
-        print(f"copied {n} files into {args.copy} (scenes/, gates/)")
+        print(f"copied {n} files into {args.copy} (scenes/, gates/, examples/, baselines/)")
         return 0
     for kind, path in example_files():
         print(f"{kind}\t{path}")

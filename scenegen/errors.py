@@ -10,6 +10,11 @@ import errno
 from dataclasses import dataclass
 
 
+#: The file name of a spec built in Python (scenegen.api): its YAML is generated, so a place in
+#: it is named by its field only, never by a line of that YAML.
+PYTHON_FILE = "<python>"
+
+
 @dataclass(frozen=True)
 class Where:
     """A place in a spec file: ``file`` as given by the user, ``line`` 1-based (or None),
@@ -20,7 +25,8 @@ class Where:
     field: str | None = None
 
     def __str__(self) -> str:
-        head = ":".join(str(p) for p in (self.file, self.line) if p is not None)
+        line = None if self.file == PYTHON_FILE else self.line  # a line of generated YAML means nothing
+        head = ":".join(str(p) for p in (self.file, line) if p is not None)
         return ": ".join(p for p in (head, self.field or "") if p)
 
 

@@ -91,15 +91,17 @@ def leaderboard_arguments(p) -> None:
 
 
 def leaderboard(a) -> int:
+    """-q: nothing printed but errors and the gates that fail (the files are written)."""
+    say = (lambda _line: None) if a.quiet else print
     gates = load_gates(a.gates) if a.gates else None  # a bad gate file fails before anything runs
-    doc = run_leaderboard(a.datasets, a.methods, a.out, declared=_declared(a))
+    doc = run_leaderboard(a.datasets, a.methods, a.out, declared=_declared(a), log=say)
     outcomes = []
     if gates:
         outcomes = evaluate(gates, [(f"leaderboard.json#runs[{k}]", r) for k, r in enumerate(doc["runs"])])
         for o in outcomes:
-            print(o.message)
+            (print if not o.passed else say)(o.message)
     for p in write_all(doc, a.out, outcomes):
-        print(f"wrote {p}")
+        say(f"wrote {p}")
     return EXIT_GATE_FAILED if any(not o.passed for o in outcomes) else 0
 
 

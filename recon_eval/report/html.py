@@ -59,6 +59,23 @@ def summary_html(doc: dict, outcomes=()) -> str:
     return "".join(parts)
 
 
+def input_rows(inputs: dict, prefix: str = "") -> list[tuple[str, str]]:
+    """The inputs as (dotted name, text) rows: nested mappings flattened, lists of plain values
+    joined by spaces, so no Python repr reaches the page."""
+    rows = []
+    for k, v in inputs.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict) and v:
+            rows += input_rows(v, name + ".")
+        elif isinstance(v, (list, tuple)) and all(not isinstance(x, (dict, list, tuple)) for x in v):
+            rows.append((name, " ".join(map(str, v))))
+        elif isinstance(v, (list, tuple)):
+            rows += input_rows({str(i): x for i, x in enumerate(v)}, name + ".")
+        else:
+            rows.append((name, str(v)))
+    return rows
+
+
 def render_html(command: str, inputs: dict, results: dict, figures: list[Figure], *, metrics: dict | None = None,
                 outcomes=()) -> str:
     """The report of one command's result (``metrics``: a run's headline numbers; ``outcomes``:
@@ -78,8 +95,8 @@ def render_html(command: str, inputs: dict, results: dict, figures: list[Figure]
     for metric, field, value in scalar_rows(results):
         parts.append(f'<tr><td>{esc(metric)}</td><td>{esc(field)}</td><td class="num">{esc(value)}</td></tr>')
     parts.append("</table><h2>Inputs</h2><table><tr><th>input</th><th>value</th></tr>")
-    for k, v in doc["inputs"].items():
-        parts.append(f"<tr><td>{esc(str(k))}</td><td>{esc(str(v))}</td></tr>")
+    for k, v in input_rows(doc["inputs"]):
+        parts.append(f"<tr><td>{esc(k)}</td><td>{esc(v)}</td></tr>")
     parts.append("</table>")
     if figures:
         parts.append("<h2>Figures</h2>")

@@ -80,6 +80,24 @@ def summary_rows(doc: dict, outcomes=()) -> list[SummaryRow]:
     rows = [SummaryRow(f"gate {o.gate.metric} {o.gate.op} {o.gate.threshold:g}",
                        "missing" if o.value is None else fmt(o.value), "pass" if o.passed else "fail", o.gate.where)
             for o in outcomes]
+    notes = (doc.get("inputs") or {}).get("notes") or {}
+    crashed = {str(item): note for item, note in (notes.items() if isinstance(notes, dict) else ())
+               if isinstance(note, dict) and note.get("failed")}
+    rows += _item_rows(doc)
+    # an item whose command failed is one row (below), not one more per number it left at inf
+    hidden = [r for r in rows[len(outcomes):] if r.name.split(".", 1)[0] in crashed]
+    rows = [r for r in rows if r not in hidden]
+    for item, note in crashed.items():
+        tail = note.get("stderr_tail") or []
+        n = sum(1 for r in hidden if r.name.split(".", 1)[0] == item)
+        rows.append(SummaryRow(item, "failed", "fail", f"{note['failed']}" + (f": {tail[-1]}" if tail else "")
+                               + (f" (no estimate: {n} result rows folded into this one)" if n else "")))
+    return rows
+
+
+def _item_rows(doc: dict) -> list[SummaryRow]:
+    """A run's headline metrics and failed flags, or a scoring command's result groups."""
+    rows: list[SummaryRow] = []
     metrics = doc.get("metrics")
     if isinstance(metrics, dict) and metrics:
         for k, v in metrics.items():
@@ -91,9 +109,4 @@ def summary_rows(doc: dict, outcomes=()) -> list[SummaryRow]:
     else:
         for name, group in (doc.get("results") or {}).items():
             rows += _group_rows(str(name), group)
-    notes = (doc.get("inputs") or {}).get("notes") or {}
-    for item, note in notes.items() if isinstance(notes, dict) else ():
-        if isinstance(note, dict) and note.get("failed"):
-            tail = note.get("stderr_tail") or []
-            rows.append(SummaryRow(f"{item}", "failed", "fail", f"{note['failed']}" + (f": {tail[-1]}" if tail else "")))
     return rows

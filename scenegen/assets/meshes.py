@@ -10,6 +10,7 @@ import numpy as np
 import trimesh
 
 from scenegen.assets import blob, cache, shapes, targets, textures
+from scenegen.geometry.conventions import zup_from_mesh_file
 
 #: Spec geometry kind -> its object-frame mesh (all centred on the object origin).
 OBJECT_MESHES = {
@@ -19,11 +20,21 @@ OBJECT_MESHES = {
     "cylinder": lambda g: shapes.cylinder(g.radius, g.height),
     "torus": lambda g: shapes.torus(g.major_radius, g.minor_radius),
     "blob": lambda g: cached_blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions),
-    "mesh": lambda g: shapes.load_mesh(g.path),
+    "mesh": lambda g: file_mesh(g.path, g.up_axis),
 }
 TARGET_KINDS = ("checkerboard", "charuco", "aruco_grid")
 #: Kinds whose shading normals are interpolated (curved surfaces approximated by triangles).
 SMOOTH_KINDS = ("cylinder", "torus", "blob", "sphere")
+
+
+def file_mesh(path, up_axis: str) -> trimesh.Trimesh:
+    """A mesh file in our Z-up object frame: a Y-up file (glTF) turned by the one conversion of
+    :func:`scenegen.geometry.conventions.zup_from_mesh_file` (UVs kept)."""
+    mesh = shapes.load_mesh(path)
+    if up_axis == "z":
+        return mesh
+    return trimesh.Trimesh(vertices=zup_from_mesh_file(mesh.vertices, up_axis), faces=mesh.faces,
+                           visual=mesh.visual, process=False)
 
 
 def object_mesh(geometry) -> tuple[trimesh.Trimesh, "targets.Board | None"]:

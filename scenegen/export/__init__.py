@@ -12,7 +12,7 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``opencv``: cv2.FileStorage YAML (K, D, R, T per view; K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q per
   stereo frame; R T E F per cross-view pair);
 * ``tum``: TUM RGB-D trajectories and per stream rgb/, depth/ (x5000), rgb.txt, depth.txt,
-  groundtruth.txt, associations.txt.
+  groundtruth.txt, associations.txt, camera.txt and orbslam.yaml (intrinsics and distortion).
 * ``tapvid``: TAP-Vid point tracks (video, normalised points, occlusion), one NPZ per stream;
 * ``tracks-video``: a GIF and an MP4 per stream of a sequence with its point tracks drawn;
 * ``kitti-flow``: KITTI 2015 flow layout (flow_occ / flow_noc PNGs) from a sequence's flow;

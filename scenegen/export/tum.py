@@ -13,12 +13,14 @@ A stream is the views of one camera name, rig and rig member, in frame order; it
   times 5000, TUM's factor: 5000 = 1 m; 0 = no surface or beyond 13.107 m), ``rgb.txt`` and
   ``depth.txt`` (``timestamp filename``), ``groundtruth.txt`` (the trajectory above) and
   ``associations.txt`` (``timestamp rgb/... timestamp depth/...``, what TUM's associate.py gives;
-  depth and colour share their timestamps exactly).
+  depth and colour share their timestamps exactly); ``camera.txt`` and ``orbslam.yaml``, the
+  camera's intrinsics and distortion (:mod:`scenegen.export.tum_calib`).
 """
 from __future__ import annotations
 
 from scenegen.dataset.codecs import encode_png
 from scenegen.export.common import depth_png16, fmt, name, write
+from scenegen.export.tum_calib import calibration_files
 from scenegen.geometry.color import to_uint8
 from scenegen.geometry.rotation import quat_wxyz_from_matrix
 
@@ -38,6 +40,7 @@ def export(ds, dest, progress=None) -> dict:
         streams.setdefault(key, []).append((info.get("time_s", info["frame_index"]), v))
     n, too_far = 0, 0
     done = 0
+    calibration: dict[str, str] = {}
     for key, items in streams.items():
         what = "time_s" if "time_s" in ds.view_info(items[0][1]) else "frame index"
         lines, rgb, depth = [TRAJECTORY_HEAD.format(what=what)], [], []
@@ -59,8 +62,17 @@ def export(ds, dest, progress=None) -> dict:
         write(dest, f"{key}/depth.txt", _list("depth maps", depth))
         assoc = "".join(f"{a} {fa} {b} {fb}\n" for (a, fa), (b, fb) in zip(rgb, depth))
         write(dest, f"{key}/associations.txt", assoc.encode())
+        info = ds.view_info(items[0][1])
+        calib = calibration_files(key, info["camera_name"], ds.camera(items[0][1])[0], [f for f, _ in sorted(items)])
+        if isinstance(calib, str):
+            calibration[key] = f"none: {calib}"
+        else:
+            for fname, data in calib.items():
+                write(dest, f"{key}/{fname}", data)
+            calibration[key] = ", ".join(calib)
+            n += len(calib)
         n += 5 + 2 * len(items)
         done += len(items)
         if progress is not None:
             progress(done, len(ds.views))
-    return {"files": n, "streams": sorted(streams), "depth_beyond_range": too_far}
+    return {"files": n, "streams": sorted(streams), "depth_beyond_range": too_far, "calibration": calibration}

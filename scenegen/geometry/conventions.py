@@ -24,6 +24,10 @@ Foreign conventions, one function (or constant) each:
 * Blender: a camera object's ``matrix_world`` uses the OpenGL camera axes; Blender's world is the
   same right-handed Z-up world as ours, so no world change is needed.
 * COLMAP poses: ``cam_from_world`` as a wxyz quaternion and a translation (images.txt).
+* Mesh files: glTF 2.0 is Y-up by its specification (+Y up, +Z the asset's front, right-handed);
+  a Y-up file's vertices enter our Z-up world through ``Z_UP_FROM_Y_UP`` (+90 degrees about x:
+  (x, y, z) -> (x, -z, y), what Blender's glTF importer does). Other mesh formats carry no axis
+  convention and are read as Z-up (``mesh_up_axis``).
 """
 from __future__ import annotations
 
@@ -77,6 +81,30 @@ def cam_from_world_from_opengl(cam_to_world) -> Rigid3:
 # Blender cameras use the OpenGL camera axes in a Z-up world identical to ours.
 blender_matrix_world = opengl_cam_to_world
 cam_from_world_from_blender = cam_from_world_from_opengl
+
+
+# --- mesh files ------------------------------------------------------------------------------
+#: x_world = Z_UP_FROM_Y_UP @ x_file for a Y-up file (glTF 2.0): +90 degrees about x, so the
+#: file's +Y (up) becomes +z and its +Z (the asset's front) becomes -y.
+Z_UP_FROM_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+#: A mesh file's up axis -> the rotation taking its vertices into our Z-up frame.
+ZUP_FROM_MESH_UP = {"z": np.eye(3), "y": Z_UP_FROM_Y_UP}
+#: File suffixes whose format fixes the up axis (glTF 2.0 spec, "Coordinate System and Units").
+Y_UP_SUFFIXES = (".gltf", ".glb")
+
+
+def mesh_up_axis(suffix: str) -> str:
+    """The up axis a mesh file of this suffix is read with by default: 'y' for glTF (its
+    specification says so), 'z' for PLY, OBJ, STL (formats without an axis convention)."""
+    return "y" if suffix.lower() in Y_UP_SUFFIXES else "z"
+
+
+def zup_from_mesh_file(vertices, up_axis: str) -> np.ndarray:
+    """(N, 3) float64 vertices of a mesh file with up axis ``up_axis`` ('y' or 'z') in our Z-up
+    object frame (a rotation: the winding is kept)."""
+    R = ZUP_FROM_MESH_UP[up_axis]
+    v = np.asarray(vertices, dtype=np.float64)
+    return v if up_axis == "z" else v @ R.T
 
 
 # --- COLMAP poses ------------------------------------------------------------------------------

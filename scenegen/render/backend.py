@@ -29,17 +29,23 @@ class BackendError(RuntimeError):
     """The requested variant cannot run on this machine."""
 
 
-def _llvm_major(path: str) -> int | None:
+def llvm_major(path: str) -> int | None:
+    """The LLVM major version of a libLLVM file, from the names Debian, Ubuntu and apt.llvm.org
+    use (``libLLVM-16.so.1``, ``libLLVM.so.19.1``, ``libLLVM-17.so``); where the file name says
+    none (``libLLVM.so.1``), its ``llvm-N`` folder (``/usr/lib/llvm-20/lib``). None: unknown."""
     m = re.search(r"libLLVM[-.]?(?:so\.)?(\d+)", os.path.basename(path))
-    return int(m.group(1)) if m else None
+    if m and int(m.group(1)) >= 4:  # an soname counter such as .so.1 is no LLVM version
+        return int(m.group(1))
+    d = re.search(r"(?:^|/)llvm-(\d+)(?:/|$)", os.path.dirname(path))
+    return int(d.group(1)) if d else None
 
 
-def find_libllvm() -> str | None:
-    """The newest libLLVM >= 16 on this machine, or None."""
+def find_libllvm(patterns=_SEARCH) -> str | None:
+    """The newest libLLVM >= 16 on this machine (files matching the glob ``patterns``), or None."""
     found = []
-    for pattern in _SEARCH:
+    for pattern in patterns:
         for path in glob.glob(pattern):
-            major = _llvm_major(path)
+            major = llvm_major(path)
             if major is not None and major >= MIN_LLVM_MAJOR and os.path.isfile(path):
                 found.append((major, path))
     return max(found)[1] if found else None
@@ -48,7 +54,7 @@ def find_libllvm() -> str | None:
 def configure_llvm() -> bool:
     """Point Dr.Jit at a good libLLVM if it has not been imported yet. True if one is set."""
     current = os.environ.get("DRJIT_LIBLLVM_PATH")
-    if current and (_llvm_major(current) or MIN_LLVM_MAJOR) >= MIN_LLVM_MAJOR and os.path.isfile(current):
+    if current and (llvm_major(current) or MIN_LLVM_MAJOR) >= MIN_LLVM_MAJOR and os.path.isfile(current):
         return True
     if "drjit" in sys.modules:
         return current is not None
@@ -91,11 +97,12 @@ def resolve_variant(requested: str = "auto") -> str:
         if llvm_available():
             return "llvm_ad_rgb"
         warnings.warn(
-            "no working libLLVM >= 16 found (install Debian's libllvm19 or set DRJIT_LIBLLVM_PATH); "
+            "no working libLLVM >= 16 found (install one of Debian's/Ubuntu's libllvm16..21, e.g. 'make llvm', "
+            "or set DRJIT_LIBLLVM_PATH); "
             "falling back to scalar_rgb, which is 40-60x slower", RuntimeWarning, stacklevel=2)
         return "scalar_rgb"
     if requested == "llvm_ad_rgb" and not llvm_available():
-        raise BackendError("llvm_ad_rgb needs libLLVM >= 16 (Debian: apt-get install libllvm19, or set "
+        raise BackendError("llvm_ad_rgb needs libLLVM >= 16 (Debian/Ubuntu: apt-get install libllvm19, or 16..21; or set "
                            "DRJIT_LIBLLVM_PATH); libLLVM 15 aborts the process and is never used")
     if requested == "cuda_ad_rgb" and not cuda_available():
         raise BackendError("cuda_ad_rgb needs an NVIDIA GPU with a working CUDA driver")

@@ -45,6 +45,7 @@ RECORDS = (
     (m.Cylinder, "objects[i].shape (type: cylinder)", {}),
     (m.Torus, "objects[i].shape (type: torus)", {}),
     (m.Blob, "objects[i].shape (type: blob)", {}),
+    (m.Mesh, "objects[i].mesh (a path, or {path, up_axis})", {}),
     (m.CheckerboardTarget, "objects[i].target (type: checkerboard)", {}),
     (m.CharucoTarget, "objects[i].target (type: charuco)", {}),
     (m.ArucoGridTarget, "objects[i].target (type: aruco_grid)", {}),

@@ -12,12 +12,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
-from scenegen.errors import SpecError
+from scenegen.errors import PYTHON_FILE, SpecError
+from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.imaging import ImagingParams
 from scenegen.spec import model as m
 from scenegen.spec.load import parse_spec
@@ -25,8 +27,6 @@ from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.materials import TYPE_KEYS as MATERIAL_KEYS
 from scenegen.spec.serialize import spec_to_dict
 
-#: The file name errors of a spec built in Python carry.
-PYTHON_FILE = "<python>"
 
 __all__ = ["PYTHON_FILE", "check_spec", "same_spec", "spec_to_yaml_dict", "to_yaml"]
 
@@ -90,7 +90,10 @@ def _material(mat) -> dict:
 
 def _geometry(g) -> tuple[str, Any]:
     if isinstance(g, m.Mesh):
-        return "mesh", g.path_as_written or str(g.path)
+        path = g.path_as_written or str(g.path)
+        if g.up_axis == mesh_up_axis(Path(path).suffix):
+            return "mesh", path
+        return "mesh", {"path": path, "up_axis": g.up_axis}
     if g.kind in m.TARGET_KINDS:
         names = [f.name for f in dataclasses.fields(g) if f.name != "kind"]
         return "target", {"type": g.kind, **_fields(g, names)}
@@ -161,7 +164,7 @@ def _sequence(q: m.SequenceSpec) -> dict:
 
 
 def _light(li) -> dict:
-    d: dict[str, Any] = {"name": li.name, "type": li.type}
+    d: dict[str, Any] = {"name": li.name, "type": li.type} if li.name is not None else {"type": li.type}
     if isinstance(li, m.PointLight):
         d.update(position=_v(li.position), intensity=_v(li.intensity))
     elif isinstance(li, m.ConstantLight):

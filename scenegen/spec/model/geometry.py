@@ -16,6 +16,7 @@ from scenegen.spec.model.limits import MAX_BOARD_SIDE
 
 SHAPE_KINDS = ("plane", "box", "sphere", "cylinder", "torus", "blob")
 MESH_SUFFIXES = (".ply", ".obj", ".glb", ".gltf", ".stl")
+MESH_UP_AXES = ("z", "y")
 TARGET_KINDS = ("checkerboard", "charuco", "aruco_grid")
 #: cv2.aruco predefined dictionaries and how many markers each holds.
 ARUCO_DICTIONARIES = {
@@ -100,6 +101,9 @@ class Mesh:
                                         "buffers)", omit_default=True)
     own_materials: bool = part(False, unit="flag: the file's own materials are rendered (the "
                                            "object has no `material:`)", omit_default=True)
+    up_axis: str = param("z", unit="axis", choices=MESH_UP_AXES, omit_default=True,
+                         derived="'y' for .gltf/.glb (the glTF 2.0 spec), else 'z'")  # the file's
+    # up axis; a Y-up file is turned into our Z-up object frame (scenegen.geometry.conventions)
     kind: str = field(default="mesh", init=False)
 
 

@@ -20,7 +20,7 @@ _INTENSITY = "linear RGB, W/sr"
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class AreaLight:
-    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     size: tuple[float, float] = param((1.0, 1.0), unit="metres", lo=0.0, lo_open=True)
     # rectangle side lengths along the light's x and y
     world_from_light: Rigid3 = part(unit="the rectangle lies in the light's z = 0 plane and "
@@ -32,7 +32,7 @@ class AreaLight:
 
 @dataclass(frozen=True, kw_only=True)
 class PointLight:
-    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     position: tuple[float, float, float] = param(unit="metres")  # world
     intensity: tuple[float, float, float] = param(unit=_INTENSITY, lo=0.0)  # radiant intensity
     where: Where | None = where_field()
@@ -41,7 +41,7 @@ class PointLight:
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class SpotLight:
-    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     position: tuple[float, float, float] = param(unit="metres")  # world
     target: tuple[float, float, float] = param(unit="metres")  # point the spot's axis passes
     # through, world
@@ -59,7 +59,7 @@ class SpotLight:
 
 @dataclass(frozen=True, kw_only=True)
 class ConstantLight:
-    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     radiance: tuple[float, float, float] = param(unit=_RADIANCE, lo=0.0)  # uniform environment
     where: Where | None = where_field()
     type: str = field(default="constant", init=False)
@@ -69,7 +69,7 @@ class ConstantLight:
 class EnvmapLight:
     """Equirectangular image; its top row is world +z (up); turned by rotation_z_deg about +z."""
 
-    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     path: Path = part(unit="absolute path of the image (EXR/HDR preferred: linear radiance)")
     path_as_written: str = part(unit="the path as in the spec")
     scale: float = param(1.0, unit="radiance multiplier", label="", lo=0.0)

@@ -7,6 +7,7 @@ from typing import Mapping
 from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
 from scenegen.assets.board_raster import BoardRasterError, layout_of, texels_per_unit
 from scenegen.errors import SpecError
+from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
@@ -56,7 +57,13 @@ def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
     error names the asset file and line) and whether its own materials are rendered: yes when
     the file has materials and the object gives none; a `material:` replaces them, with a
     warning."""
+    up_node = None
+    if node.is_mapping:  # `mesh: {path: ..., up_axis: y}`
+        f = node.as_mapping("a mesh (a file path, or a mapping with 'path' and 'up_axis')")
+        f.check(required=("path",), optional=("up_axis",))
+        up_node, node = f.get("up_axis"), f.get("path")
     path, written = node.as_path(mg.MESH_SUFFIXES, "mesh")
+    up_axis = mesh_up_axis(path.suffix) if up_node is None else up_node.as_enum(mg.MESH_UP_AXES, "up axis")
     try:
         scan = scan_mesh_file(path)
     except AssetFileError as e:
@@ -68,7 +75,7 @@ def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
         ctx.warn(mat_node, f"the mesh {written!r} has its own materials ({what}); this "
                  "`material:` replaces them all (leave it out to render the file's materials)")
     return mg.Mesh(path=path, path_as_written=written, files=files,
-                   own_materials=scan.has_materials and mat_node is None)
+                   own_materials=scan.has_materials and mat_node is None, up_axis=up_axis)
 
 
 def object_material(mat_node: Node | None, node: Node, materials: Mapping[str, Material],

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from scenegen.located_yaml import Node
 from scenegen.spec.model.meta import spec_fields
-from scenegen.spec.model.render import RenderSettings, effective_spp
+from scenegen.spec.model.render import RenderSettings
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.read import read_enum, read_int
 
@@ -20,9 +20,8 @@ def parse_render(node: Node | None, ctx: ParseContext) -> RenderSettings:
     if max_depth == 0:
         raise f.get("max_depth").error("expected -1 (unbounded) or a positive integer, got 0")
     sampler = read_enum(f, R, "sampler")
-    if (n := effective_spp(sampler, spp)) != spp:
-        ctx.warn(f.get("spp") or node, f"spp = {spp}: Mitsuba's {sampler} rounds it up to {n} "
-                 "samples per pixel (recorded as render_used.spp_effective)")
+    # No warning when the sampler rounds spp up: `render` asks for the count it takes and says so
+    # in its summary ('spp 1 (sampler takes 4)', whatever --spp overrides), `validate` in its line.
     return RenderSettings(
         spp=spp, max_depth=max_depth, seed=read_int(f, R, "seed"),
         variant=read_enum(f, R, "variant"), bit_depth=read_enum(f, R, "bit_depth"),

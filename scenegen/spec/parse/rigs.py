@@ -14,6 +14,20 @@ from scenegen.spec.parse.transforms import parse_pose
 STEREO_MEMBERS = ("left", "right")
 
 
+def stereo_rig(name: str, left: str, right: str, baseline_m: float, vergence_deg: float = 0.0,
+               where=None) -> Rig:
+    """A stereo rig: the left camera at the rig origin, the right one at (+baseline_m, 0, 0), each
+    turned by vergence_deg / 2 about its y axis toward the other."""
+    half = math.radians(vergence_deg) / 2
+    members = (
+        RigMember(name="left", camera=left, rig_from_cam=Rigid3.from_rotvec([0.0, half, 0.0], [0.0, 0.0, 0.0])),
+        RigMember(name="right", camera=right,
+                  rig_from_cam=Rigid3.from_rotvec([0.0, -half, 0.0], [baseline_m, 0.0, 0.0])),
+    )
+    return Rig(name=name, type="stereo", members=members, baseline_m=baseline_m, vergence_deg=vergence_deg,
+               where=where)
+
+
 def parse_rig(node: Node, name: str, ctx: ParseContext) -> Rig:
     f = node.as_mapping("a rig (a mapping with 'type': stereo or multi)")
     kind = f.req("type").as_enum(RIG_TYPES, "rig type")
@@ -22,15 +36,7 @@ def parse_rig(node: Node, name: str, ctx: ParseContext) -> Rig:
         left, right = (camera_ref(f.get(k), ctx.cameras) for k in STEREO_MEMBERS)
         baseline = read_float(f, Rig, "baseline_m")
         vergence = read_float(f, Rig, "vergence_deg")
-        half = math.radians(vergence) / 2
-        members = (
-            RigMember(name="left", camera=left,
-                      rig_from_cam=Rigid3.from_rotvec([0.0, half, 0.0], [0.0, 0.0, 0.0])),
-            RigMember(name="right", camera=right,
-                      rig_from_cam=Rigid3.from_rotvec([0.0, -half, 0.0], [baseline, 0.0, 0.0])),
-        )
-        return Rig(name=name, type=kind, members=members, baseline_m=baseline,
-                   vergence_deg=vergence, where=node.where)
+        return stereo_rig(name, left, right, baseline, vergence, where=node.where)
     f.check(required=("type", "members"))
     members, seen = [], {}
     for item in f.get("members").items("a list of rig members"):

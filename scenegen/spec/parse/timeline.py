@@ -184,11 +184,17 @@ def parse_animation(f: Fields, node: Node, transform: Transform, ctx: ParseConte
         parent=parent, rest=rest,
         trajectory=parse_trajectory(f.get("trajectory"), "object") if which == "trajectory" else None,
         joint=parse_joint(f.get("joint")) if which == "joint" else None, visible_s=visible)
-    t0 = ctx.sequence.timestamps_s[0]
+    return anim, start_transform(anim, transform.scale, ctx.objects, ctx.sequence)
+
+
+def start_transform(anim: mt.Animation, scale, objects, sequence: mt.SequenceSpec) -> Transform:
+    """An animated object's resolved ``transform``: its world pose at frame 0 (through its parent,
+    one of ``objects``, the objects before it) with its ``scale``."""
+    t0 = sequence.timestamps_s[0]
     pose = local_trajectory(anim).state(t0).world_from_frame  # parent_from_object at frame 0
-    if parent is not None:
-        pose = object_states(ctx.objects, t0)[parent].world_from_object @ pose
-    return anim, Transform(world_from_object=pose, scale=transform.scale)
+    if anim.parent is not None:
+        pose = object_states(objects, t0)[anim.parent].world_from_object @ pose
+    return Transform(world_from_object=pose, scale=scale)
 
 
 def _is_sphere(shape: Node) -> bool:

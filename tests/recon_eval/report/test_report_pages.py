@@ -88,6 +88,26 @@ def test_summary_of_a_run_lists_failed_invocations():
                                                           ("a__b", "fail", "exit status 3: boom")]
 
 
+def test_one_failed_invocation_is_one_row_and_the_inputs_are_words_not_reprs():
+    """A pair whose command crashed left four numbers at inf in two result groups: the summary
+    shows one FAIL row for it (the other pair's rows stay), the inputs table no Python dict."""
+    notes = {"a__b": {"failed": "exit status 1", "stderr_tail": ["Traceback", "boom"], "argv": ["python", "m.py"]},
+             "a__b.truth": {"pixels": "distorted"}}
+    doc = {"command": "run", "inputs": {"method": "mine", "notes": notes},
+           "metrics": {"a__b.sampson_rms_px": "inf", "a__b.pose_err_deg": "inf", "a__c.sampson_rms_px": 0.4},
+           "results": {"a__b.fundamental": {"sampson_rms_px": "inf", "failed": True, "failure_reason": "non-finite"},
+                       "a__b.pose_via_K": {"pose_err_deg": "inf", "failed": True, "failure_reason": "non-finite"},
+                       "a__c.fundamental": {"sampson_rms_px": 0.4, "failed": False}}}
+    rows = summary_rows(doc)
+    assert [(r.name, r.status) for r in rows] == [("a__c.sampson_rms_px", "info"), ("a__c.fundamental", "ok"),
+                                                  ("a__b", "fail")]
+    assert rows[-1].note == "exit status 1: boom (no estimate: 4 result rows folded into this one)"
+    page = render_html("run", doc["inputs"], doc["results"], [], metrics=doc["metrics"])
+    assert page.count('<tr class="fail">') == 1
+    assert "{&#x27;" not in page and "[&#x27;" not in page  # no repr of a dict or a list
+    assert "<td>notes.a__b.argv</td><td>python m.py</td>" in page and "<td>notes.a__b.truth.pixels</td>" in page
+
+
 @pytest.mark.parametrize("metric, higher", [
     ("synthetic.sampson_rms_px", False), ("sift.inlier_recall", True), ("bad_2_0_noc_pct", False),
     ("invalid_noc_pct", False), ("registration_ratio", True), ("points.failure_ratio", False),

@@ -339,3 +339,10 @@ def test_leaderboard_with_declared_methods_and_gates(plane_dataset, tmp_path, ca
     report = (tmp_path / "b" / json.loads((tmp_path / "b" / "leaderboard.json").read_text())["run_dirs"][0]
               / "report.html").read_text()
     assert "gate n_points3d &gt;= 100" in report and 'class="verdict fail"' in report
+    # -q: the same files, and nothing printed but the failed gate (no run lines, no 'wrote')
+    code, out, err = run(["-q", "leaderboard", "--methods-file", tmp_path / "m.yaml", "--datasets", root, "--methods",
+                          "my-sfm", "opencv-stereo-bm", "--gates", tmp_path / "g.yaml", "-o", tmp_path / "q"], capsys)
+    assert code == 1 and err == ""
+    (line,) = out.splitlines()
+    assert line.startswith("FAIL n_points3d = 1, threshold >= 100"), out
+    assert (tmp_path / "q" / "leaderboard.html").is_file()

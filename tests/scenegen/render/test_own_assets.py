@@ -64,7 +64,8 @@ def write_obj(folder, mtl_text=None):
 def write_glb(folder, tex, **pbr):
     from PIL import Image
 
-    m = trimesh.Trimesh(vertices=[[0, -0.5, 0], [1, -0.5, 0], [1, 0.5, 0], [0, 0.5, 0]],
+    # glTF is Y-up: the quad x in [0, 1], y in [-0.5, 0.5] of our z = 0 plane is (x, 0, -y) in the file
+    m = trimesh.Trimesh(vertices=[[0, 0, 0.5], [1, 0, 0.5], [1, 0, -0.5], [0, 0, -0.5]],
                         faces=[[0, 1, 2], [0, 2, 3]], process=False)
     mat = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.fromarray(tex), **pbr)
     m.visual = trimesh.visual.TextureVisuals(uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), material=mat)
@@ -255,7 +256,8 @@ def test_gltf_alpha_mask_truth_follows_the_holes(tmp_path):
     rgba[..., 0] = 230
     rgba[..., 3] = 255
     rgba[::2, ::2, 3] = rgba[1::2, 1::2, 3] = 20  # holes (alpha 0.08 < cutoff 0.5)
-    m = trimesh.Trimesh(vertices=[[-1, -0.5, 0.4], [1, -0.5, 0.4], [1, 0.5, 0.4], [-1, 0.5, 0.4]],
+    # in z = 0.4 of our world; glTF is Y-up, so the file holds (x, 0.4, -y)
+    m = trimesh.Trimesh(vertices=[[-1, 0.4, 0.5], [1, 0.4, 0.5], [1, 0.4, -0.5], [-1, 0.4, -0.5]],
                         faces=[[0, 1, 2], [0, 2, 3]], process=False)
     mat = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.fromarray(rgba, "RGBA"),
                                               alphaMode="MASK", alphaCutoff=0.5, metallicFactor=0.0)
@@ -296,10 +298,11 @@ def test_mtl_specular_and_emission(tmp_path, capsys):
 def test_gltf_with_two_meshes_keeps_each_material(tmp_path):
     """A glTF scene of two meshes (two materials, node transforms): each part its own colour, one
     object id, and the dataset's world mesh is the whole flattened file."""
-    from scenegen.assets.shapes import load_mesh
+    from scenegen.assets.meshes import file_mesh
 
     def quad(x0, rgb):
-        m = trimesh.Trimesh(vertices=[[0, -0.5, 0], [1, -0.5, 0], [1, 0.5, 0], [0, 0.5, 0]],
+        # glTF is Y-up: (x, 0, -y) in the file is (x, y, 0) in our world
+        m = trimesh.Trimesh(vertices=[[0, 0, 0.5], [1, 0, 0.5], [1, 0, -0.5], [0, 0, -0.5]],
                             faces=[[0, 1, 2], [0, 2, 3]], process=False)
         m.visual = trimesh.visual.TextureVisuals(
             uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]),
@@ -316,7 +319,8 @@ def test_gltf_with_two_meshes_keeps_each_material(tmp_path):
     assert a[0] > 3 * a[2] and b[2] > 2 * b[0]  # red left, blue right
     assert set(np.unique(truth["object_id"][truth["valid"]])) == {1}
     stored = ds.mesh("q")
-    np.testing.assert_allclose(np.asarray(stored.vertices), load_mesh(tmp_path / "two.glb").vertices, atol=1e-6)
+    np.testing.assert_allclose(np.asarray(stored.vertices), file_mesh(tmp_path / "two.glb", "y").vertices, atol=1e-6)
+    np.testing.assert_allclose(np.asarray(stored.vertices)[:, 2], 0.0, atol=1e-6)  # Y-up file, our z = 0
 
 
 def test_colour_variation_of_a_mesh_with_its_own_materials_is_refused(tmp_path):

@@ -287,14 +287,21 @@ def test_effective_spp_is_what_mitsuba_takes(mi, sampler):
 
 
 @pytest.mark.render
-def test_spp_warning_and_record(tmp_path):
+def test_spp_rounding_is_stated_not_warned_and_recorded(tmp_path, capsys):
+    from scenegen.cli import main
     from scenegen.pipeline.run import render_spec
 
     spec = ("render: {spp: 8}\nobjects: [{name: p, shape: plane}]\ncameras: {c: {size: [8, 6], fx: 8}}\n"
             "views: [{camera: c, look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]}]\n")
     s = parse_spec(spec, "s.yaml")
-    assert any("ldsampler rounds it up to 16" in w for w in s.warnings)
+    assert s.warnings == ()  # the rounding is stated by validate and render, not warned about
     (tmp_path / "s.yaml").write_text(spec)
+    assert main(["validate", str(tmp_path / "s.yaml")]) == 0
+    out, err = capsys.readouterr()
+    assert "spp 8 (the ldsampler takes 16)" in out and err == ""
+    assert main(["render", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "o1"), "--spp", "1", "--no-progress"]) == 0
+    out, err = capsys.readouterr()
+    assert "spp 1 (sampler takes 4)" in out and "warning" not in err, err
     out = render_spec(tmp_path / "s.yaml", tmp_path / "out", progress=False)
     assert (out.settings.spp, out.settings.spp_effective) == (8, 16)
     import json

@@ -88,9 +88,10 @@ class TestDefaults:
         (tmp_path / "my_scene.yaml").write_text("seed: 1\n")
         assert load_spec(tmp_path / "my_scene.yaml").name == "my_scene"
 
-    def test_spp_not_power_of_two_warns(self):
+    def test_spp_the_sampler_rounds_up_is_kept_without_a_warning(self):
+        # validate and the render summary state the rounding (tests/scenegen/render/test_render.py)
         spec = parse("render: {spp: 100}\n")
-        assert len(spec.warnings) == 1 and "render.spp" in spec.warnings[0]
+        assert spec.render.spp == 100 and spec.warnings == ()
 
     def test_yaml_11_exponent_without_dot_is_a_number(self):
         spec = parse("objects: [{name: s, shape: {type: sphere, radius: 1e-3}}]\n")
