@@ -22,7 +22,7 @@ from scenegen.pipeline.distributed import note_stage_items, worker_scene
 from scenegen.pipeline.progress import ViewProgress
 
 #: Item groups per worker: small enough to balance, large enough to share cached truth.
-GROUPS_PER_WORKER = 4
+GROUPS_PER_WORKER = 2
 
 
 class WriterSink:
