@@ -172,6 +172,8 @@ def _gltf_json(path: Path) -> tuple[dict, str | None]:
         return json.loads(text), text
     except (ValueError, UnicodeDecodeError) as e:
         raise AssetFileError(f"could not be read as glTF ({e})", path, None) from None
+    except RecursionError:  # a hostile file: arrays or objects nested thousands deep
+        raise AssetFileError("could not be read as glTF (invalid JSON: nested too deeply)", path, None) from None
 
 
 def _line_of(text: str | None, needle: str) -> int | None:
