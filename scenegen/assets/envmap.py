@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import OpenEXR
-from PIL import Image
+from PIL import Image, UnidentifiedImageError
 
 from scenegen.assets.checks import ENVMAP_SUFFIXES, MAX_TEXTURE_PIXELS
 from scenegen.quiet import decode_image, quiet_native_output
@@ -63,7 +63,8 @@ def header_size(path: Path) -> tuple[int, int]:
             with Image.open(path) as im:
                 return im.size
     except (OSError, Image.DecompressionBombError, ValueError) as e:
-        raise ValueError(f"not a readable {suffix[1:].upper()} image ({e})") from None
+        why = "its content is not of that format" if isinstance(e, UnidentifiedImageError) else str(e)
+        raise ValueError(f"not a readable {suffix[1:].upper()} image ({why})") from None
 
 
 def check_envmap(path) -> tuple[int, int]:
