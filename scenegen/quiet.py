@@ -3,16 +3,18 @@
 OpenCV logs ``[ WARN:0@...]`` / ``[ERROR:0@...]`` lines (libpng's complaints, ``imdecode_``)
 and OpenEXR prints ``Warning: ...`` on stdout and ``(EXR_ERR_...)`` lines on stderr when a file
 is bad; every decode whose failure we report ourselves (one line naming the file) goes through
-:func:`quiet_native_output`, so those lines never come before our error. Python-level output is
-untouched: only the process's file descriptors 1 and 2 are pointed at /dev/null for the call
-(the C libraries write there directly), under a lock, and OpenCV's log level is lowered for it.
+:func:`quiet_native_output`, so those lines never come before our error. For the call only,
+under a lock: the process's file descriptors 1 and 2 point at /dev/null (the C libraries write
+there), ``sys.stdout``/``sys.stderr`` at a discarded buffer (the bindings also print through
+Python), and OpenCV's log level is silent; all three are restored after, also on an error.
 """
 from __future__ import annotations
 
+import io
 import os
 import sys
 import threading
-from contextlib import contextmanager
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import cv2
 import numpy as np
@@ -44,7 +46,8 @@ def quiet_native_output():
                         pass
             finally:
                 os.close(null)
-            yield
+            with redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()):  # bindings print via Python too
+                yield
         finally:
             for fd, copy in saved:
                 os.dup2(copy, fd)

@@ -29,7 +29,7 @@ MIN_TILE_WIDTH_PX = 16
 #: of a spec (MAX_IMAGE_SIDE_PX, 16,384, docs/scene_spec.md 'Limits') give or take the gaps.
 MAX_TILE_WIDTH_PX = 4096
 #: Most pixels of one sheet: 2^28 (768 MB of RGB while it is composed and encoded; the default
-#: 160 px tiles of 4:3 views fit about 2,800 views). Checked before anything is rendered or read.
+#: 160 px tiles of 4:3 views fit 2,968 views). Checked before anything is rendered or read.
 MAX_SHEET_PIXELS = 1 << 28
 
 

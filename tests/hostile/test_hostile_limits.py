@@ -36,6 +36,7 @@ def test_a_spec_name_fits_a_dataset_file_name():
 @pytest.mark.parametrize("value,shown", [
     (limits.MAX_IMAGE_SIDE_PX, "16,384 px"), (limits.MAX_IMAGE_PIXELS, "67,108,864"), (limits.MAX_SPP, "65,536"),
     (limits.MAX_VIEWS, "1,000,000"), (limits.MAX_BOARD_SIDE, "512"), (checks.MAX_TEXTURE_PIXELS, "2^26"),
+    (limits.MAX_TRACKS, "1,000,000"),
     (checks.MAX_MESH_FACES, "50,000,000"), (checks.MAX_MESH_FILE_BYTES, "4 GiB"),
     (located_yaml.MAX_NAME_LEN, "128 characters"), (source.MAX_SOURCE_BYTES, "1 MiB")])
 def test_every_limit_is_documented_with_its_value(value, shown):
