@@ -93,3 +93,19 @@ def test_hostile_api_call(cid, call, kind, fragment):
         call()
     assert type(info.value) is kind and not isinstance(info.value, AttributeError), repr(info.value)
     assert fragment in str(info.value), str(info.value)
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("target,written", [("[0, 0, 1.8]", 0), ("[0, 0, 1.2]", 312)])
+def test_fewer_tracks_than_asked_are_said_not_silent(tmp_path, target, written):
+    """A count the query frames' surface cannot fill (issue 25: 812 tracks written for 10^9, exit
+    0, no word) is a warning with the count written; a frame with no surface at all used to crash
+    the correspondence kernel (Dr.Jit: incompatible sizes 0 and 1)."""
+    spec = tmp_path / "short.yaml"
+    spec.write_text(SEQUENCE_SPEC.replace("count: 24", "count: 1700").replace("frames: 3", "frames: 2")
+                    .replace("target: [0, 0, 0]}", f"target: {target}}}"))
+    with pytest.warns(RuntimeWarning, match=f"stream 'cam': {written:,} of 1,700 tracks written"):
+        assert main(["render", str(spec), "-o", str(tmp_path / "out"), "-q"]) == 0
+    from scenegen.dataset import Dataset
+
+    assert len(Dataset(tmp_path / "out").sequence.tracks("cam")) == written
