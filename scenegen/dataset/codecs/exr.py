@@ -66,7 +66,8 @@ def _read(source, what: str, header_only: bool = False):
             channels = None if header_only else {name: np.ascontiguousarray(ch.pixels)
                                                  for name, ch in f.channels().items()}
     except Exception as e:  # OpenEXR raises bare Exception/RuntimeError on bad data
-        raise ValueError(f"{what}not a readable EXR file ({e})") from None
+        why = str(e).replace(f"'{source}'" if isinstance(source, str) else "'<python_buffer>'", "it")
+        raise ValueError(f"{what}not a readable EXR file ({why})") from None  # the path named once
     return f, channels
 
 
