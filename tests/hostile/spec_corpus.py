@@ -3,6 +3,8 @@ fragment ``scenegen validate`` must print and the exit code. Generated from this
 stored as files; tests/hostile/test_hostile_spec_corpus.py runs every case through the CLI."""
 from __future__ import annotations
 
+import json
+
 import cv2
 import numpy as np
 
@@ -191,6 +193,9 @@ for name, path, frag in [("text_exr", "text.exr", "not a readable EXR file"), ("
 # --- a mesh file's own materials and structure ------------------------------------------------------
 case("mtl_texture_garbage_png", sub("lights:", MESH.format(path="mtl_bad.obj") + "lights:"), "could not decode it")
 case("gltf_nested_100000", sub("lights:", MESH.format(path="deep.gltf") + "lights:"), "nested too deeply")
+case("gltf_node_chain_100000", sub("lights:", MESH.format(path="chain.gltf") + "lights:"),
+     "nodes are nested more than 1024 levels deep")
+case("gltf_node_cycle", sub("lights:", MESH.format(path="cycle.gltf") + "lights:"), "a node is its own ancestor")
 # --- sequences: what a sequence can give, and numbers derived from the spec's (issue 25) -------------
 SEQ_VIEWS = sub("    orbit: {center: [0, 0, 0], radius_m: 2.0, elevations_deg: [30], count: 3}",
                 "    trajectory: {keyframes: [{time_s: 0, eye: [0, -2, 1.5], target: [0, 0, 0]}]}")
@@ -249,3 +254,11 @@ def write_assets(d) -> None:
                                    "usemtl a\nf 1/1 2/2 3/3\n")
     (d / "bad.mtl").write_text("newmtl a\nKd 1 1 1\nmap_Kd corrupt.png\n")
     (d / "deep.gltf").write_text('{"asset": {"version": "2.0"}, "extras": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    tri = {"meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+           "bufferViews": [{"buffer": 0, "byteLength": 36}],
+           "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + "A" * 48}]}
+    chain = [{"children": [i + 1]} for i in range(99_999)] + [{"mesh": 0}]
+    for name, nodes in [("chain", chain), ("cycle", [{"children": [1], "mesh": 0}, {"children": [0]}])]:
+        (d / f"{name}.gltf").write_text(json.dumps({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+                                                    "nodes": nodes, **tri}))
