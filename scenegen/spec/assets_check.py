@@ -31,7 +31,7 @@ def check_assets(spec) -> None:
     for obj in spec.objects:
         with located(obj, f"object {obj.name!r}"):
             meshes.object_mesh(obj.geometry)
-            if obj.geometry.kind == "mesh":
+            if obj.geometry.kind == "mesh" and obj.geometry.own_materials:  # render's condition
                 mesh_parts(obj.geometry.path)  # the MTL's / glTF's images, as render reads them
         texture = getattr(obj.material, "texture", None)
         if texture is not None:

@@ -191,7 +191,9 @@ for name, path, frag in [("text_exr", "text.exr", "not a readable EXR file"), ("
                          ("directory", "dir.exr", "is a directory"), ("ok_hdr", "ok.hdr", "OK"), ("ok_exr", "ok.exr", "OK")]:
     case(f"envmap_{name}", sub("lights:\n", "lights:\n" + ENV.format(path=path)), frag, 0 if frag == "OK" else 2)
 # --- a mesh file's own materials and structure ------------------------------------------------------
-case("mtl_texture_garbage_png", sub("lights:", MESH.format(path="mtl_bad.obj") + "lights:"), "could not decode it")
+OWN = "  - name: thing\n    mesh: {path}\n"  # rendered with the file's own materials (no `material:`)
+case("mtl_texture_garbage_png", sub("lights:", OWN.format(path="mtl_bad.obj") + "lights:"), "could not decode it")
+case("mtl_texture_replaced_ok", sub("lights:", MESH.format(path="mtl_bad.obj") + "lights:"), "OK", 0)  # not read
 case("gltf_nested_100000", sub("lights:", MESH.format(path="deep.gltf") + "lights:"), "nested too deeply")
 case("gltf_node_chain_100000", sub("lights:", MESH.format(path="chain.gltf") + "lights:"),
      "nodes are nested more than 1024 levels deep")
