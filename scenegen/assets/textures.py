@@ -18,7 +18,6 @@ import inspect
 from pathlib import Path
 from typing import Callable
 
-import cv2
 import numpy as np
 
 from scenegen.assets.checks import MAX_TEXTURE_PIXELS
