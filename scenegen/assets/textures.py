@@ -21,8 +21,8 @@ from typing import Callable
 import numpy as np
 
 from scenegen.assets.checks import MAX_TEXTURE_PIXELS
-from scenegen.quiet import decode_image
 from scenegen.geometry.color import linear_from_srgb
+from scenegen.quiet import decode_image
 
 Color = tuple[float, float, float]
 

@@ -11,8 +11,8 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 import OpenEXR
 
-from scenegen.quiet import quiet_native_output
 from scenegen.dataset.files import atomic_write_bytes
+from scenegen.quiet import quiet_native_output
 
 _EXR_DTYPES = (np.dtype(np.float32), np.dtype(np.uint32))
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from scenegen.quiet import decode_image
 from scenegen.dataset.files import atomic_write_bytes, read_decoded
+from scenegen.quiet import decode_image
 
 _PNG_COMPRESSION = 3  # zlib level; any level is lossless, fixed so bytes don't follow cv2 defaults
 

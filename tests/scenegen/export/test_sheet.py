@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from scenegen.export.sheet import (
-    GAP_PX, LABEL_PX, MAX_SHEET_PIXELS, MAX_TILE_WIDTH_PX, KINDS, check_sheet_size, check_tile_width, compose,
+    GAP_PX, KINDS, LABEL_PX, MAX_SHEET_PIXELS, MAX_TILE_WIDTH_PX, check_sheet_size, check_tile_width, compose,
     depth_tile, id_colours, normals_tile, resized, view_tiles,
 )
 from scenegen.spec.model.limits import MAX_IMAGE_SIDE_PX
