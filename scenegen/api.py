@@ -22,7 +22,7 @@ import dataclasses
 import math
 from os import PathLike
 from pathlib import Path
-from typing import Iterable, Mapping
+from typing import Iterable, Mapping, get_args
 
 from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
 from scenegen.errors import SpecError
@@ -39,7 +39,8 @@ from scenegen.spec.model import (  # re-exported: the building blocks
     Transform, ViewSet,
 )
 from scenegen.spec.model.geometry import AssetFile, Mesh
-from scenegen.spec.model.materials import PrincipledMaterial
+from scenegen.spec.model.lights import Light
+from scenegen.spec.model.materials import Material, PrincipledMaterial
 from scenegen.spec.model.meta import frozen_mapping
 from scenegen.spec.model.timeline import Animation, JointSpec, Keyframe, SequenceSpec, TrackSpec, TrajectorySpec
 from scenegen.spec.model.views import TrajectoryPath
@@ -152,6 +153,38 @@ def camera(name: str, *, size, fx: float | None = None, fy: float | None = None,
                       skew=skew, dist=tuple(dist), fov_deg=fov_deg, optics=optics, imaging=imaging)
 
 
+def _checked(value, arg: str, kinds: tuple, *, mapping: bool = False):
+    """``value`` of argument ``arg`` when it is a list or tuple (or, where ``mapping``, a mapping
+    name -> item) of ``kinds``; a SpecError naming the argument (and the item) otherwise, never
+    the AttributeError of a later ``.name``."""
+    names = " | ".join(k.__name__ for k in kinds)
+
+    def check(item, field):
+        if not isinstance(item, kinds):
+            raise SpecError(f"expected a {names}, got {type(item).__name__} {item!r:.60}", file=PYTHON_FILE,
+                            field=field)
+    if mapping and isinstance(value, Mapping):
+        for k, v in value.items():
+            check(v, f"{arg}.{k}")
+        return value
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Iterable):
+        form = "a list (or a mapping name -> item)" if mapping else "a list"
+        raise SpecError(f"expected {form} of {names}, got {type(value).__name__} {value!r:.60}",
+                        file=PYTHON_FILE, field=arg)
+    value = list(value)
+    for i, item in enumerate(value):
+        check(item, f"{arg}[{i}]")
+    return value
+
+
+def _one(value, arg: str, kind: type, what: str):
+    """``value`` when it is None or a ``kind``; SpecError naming the argument otherwise."""
+    if value is not None and not isinstance(value, kind):
+        raise SpecError(f"expected {what} or None, got {type(value).__name__} {value!r:.60}", file=PYTHON_FILE,
+                        field=arg)
+    return value
+
+
 def _named(things, what: str) -> dict:
     """A mapping name -> thing (a mapping, or things with a ``name``), names filled in."""
     if isinstance(things, Mapping):
@@ -226,6 +259,15 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
     (default: the current directory); ``sequence`` (:func:`sequence`) makes it a sequence: an
     animated object's pose at frame 0 and a trajectory placement's times come from it.
     SpecError naming the field on a bad value."""
+    objects = _checked(objects, "objects", (SceneObject,))  # the arguments' types first: errors name them
+    lights = _checked(lights, "lights", get_args(Light))
+    cameras = _checked(cameras, "cameras", (CameraSpec,), mapping=True)
+    rigs = _checked(rigs, "rigs", (Rig,), mapping=True)
+    views = _checked(views, "views", (ViewSet,))
+    materials = _checked(materials, "materials", get_args(Material), mapping=True)
+    render = _one(render, "render", RenderSettings, "RenderSettings")
+    crossview = _one(crossview, "crossview", CrossviewSpec, "a CrossviewSpec")
+    sequence = _one(sequence, "sequence", SequenceSpec, "a SequenceSpec (scenegen.api.sequence)")
     base = Path(base_dir).resolve() if base_dir is not None else Path.cwd()
     mats = {k: _resolved_paths(v, base, f"materials.{k}") for k, v in _named(materials, "material").items()}
     objs = []

@@ -51,7 +51,8 @@ def cmd_validate(args) -> int:
     spec = load_spec(args.spec)
     views = resolve_views(spec)
     if any(o.geometry.kind == "mesh" or getattr(getattr(o.material, "texture", None), "kind", "") == "image"
-           for o in spec.objects):  # files render would read: read them as it does (trimesh, cv2 only then)
+           for o in spec.objects) or any(light.type == "envmap" for light in spec.lights):
+        # files render would read: read them as it does (trimesh, cv2, OpenEXR only then)
         from scenegen.spec.assets_check import check_assets  # the command's implementation, on use
         check_assets(spec)  # errors at the spec's file:line
     for name, cam in spec.cameras.items():

@@ -105,8 +105,11 @@ SCENEGEN_LAYERS = {
     "scenegen.bundled": (),  # the package data (example scenes and gates), standard library only
     "scenegen.located_yaml": ("scenegen.errors",),
     "scenegen.geometry": (),
-    "scenegen.dataset": ("scenegen.geometry",),
-    "scenegen.assets": ("scenegen.geometry",),
+    # decoding without the native libraries' own lines (OpenCV, OpenEXR): the one helper that
+    # silences them, below the dataset's codecs and the asset loaders that both decode images
+    "scenegen.quiet": (),
+    "scenegen.dataset": ("scenegen.geometry", "scenegen.quiet"),
+    "scenegen.assets": ("scenegen.geometry", "scenegen.quiet"),
     "scenegen.imaging": ("scenegen.geometry", "scenegen.dataset"),
     "scenegen.crossview": ("scenegen.geometry", "scenegen.dataset"),
     "scenegen.spec": ("scenegen.errors", "scenegen.located_yaml", "scenegen.geometry", "scenegen.assets",

@@ -13,6 +13,9 @@ MAX_MESH_FILE_BYTES = 4 << 30
 #: Most pixels of a procedural texture: 2^26 (as an image, scenegen.spec.model.limits). Why: it is
 #: made as float64 RGB (24 bytes per texel, 1.6 GB at this size) before the renderer gets it.
 MAX_TEXTURE_PIXELS = 1 << 26
+#: Environment map files: what the renderer's image reader (Mitsuba's Bitmap) reads among the
+#: spec's image suffixes: no TIFF.
+ENVMAP_SUFFIXES = (".exr", ".hdr", ".png", ".jpg", ".jpeg", ".bmp")
 
 
 def positive(name: str, value) -> float:

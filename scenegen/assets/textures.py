@@ -18,11 +18,11 @@ import inspect
 from pathlib import Path
 from typing import Callable
 
-import cv2
 import numpy as np
 
 from scenegen.assets.checks import MAX_TEXTURE_PIXELS
 from scenegen.geometry.color import linear_from_srgb
+from scenegen.quiet import decode_image
 
 Color = tuple[float, float, float]
 
@@ -310,15 +310,15 @@ def load_image(path) -> np.ndarray:
         raise ValueError(f"texture image {str(p)!r}: is a directory, expected a PNG or JPEG file")
     if not p.is_file():
         raise ValueError(f"texture image {str(p)!r}: file not found")
-    # imdecode on the bytes avoids cv2.imread's silent None on non-ASCII paths.
-    raw = np.frombuffer(p.read_bytes(), dtype=np.uint8)
-    if raw.size == 0:
+    # decoded from the bytes: no cv2.imread None on non-ASCII paths, no OpenCV log lines
+    raw = p.read_bytes()
+    if not raw:
         raise ValueError(f"texture image {str(p)!r}: the file is empty")
     try:
-        img = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED)
-    except cv2.error as e:  # e.g. a header announcing more pixels than OpenCV allows
-        raise ValueError(f"texture image {str(p)!r}: OpenCV could not decode it ({str(e).strip().splitlines()[-1]})") from None
-    if img is None or img.size == 0:
+        img = decode_image(raw)
+    except ValueError as e:  # e.g. a header announcing more pixels than OpenCV allows
+        raise ValueError(f"texture image {str(p)!r}: {e}") from None
+    if img is None:
         raise ValueError(f"texture image {str(p)!r}: OpenCV could not decode it")
     if img.dtype == np.uint8:
         enc = img.astype(np.float64) / 255.0
@@ -404,7 +404,10 @@ def make_texture(kind: str, params: dict | None = None, seed: int = 0) -> np.nda
 
 def load_data_image(path: Path) -> np.ndarray:
     """An 8- or 16-bit image read as data (no sRGB decoding): (H, W, 3) float32 in [0, 1]."""
-    img = cv2.imdecode(np.frombuffer(Path(path).read_bytes(), np.uint8), cv2.IMREAD_UNCHANGED)
+    try:
+        img = decode_image(Path(path).read_bytes())
+    except ValueError as e:
+        raise ValueError(f"texture image {str(path)!r}: {e}") from None
     if img is None or img.dtype not in (np.uint8, np.uint16):
         raise ValueError(f"texture image {str(path)!r}: OpenCV could not decode it as 8/16-bit")
     a = img.astype(np.float64) / (255.0 if img.dtype == np.uint8 else 65535.0)

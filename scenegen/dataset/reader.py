@@ -96,8 +96,9 @@ class Dataset:
         p = self._file(rel_path, what)
         try:
             return reader(p)
-        except (ValueError, KeyError, OSError) as e:
-            raise DatasetError(f"{p}: unreadable {what}: {str(e).removeprefix(f'{p}: ')}") from None
+        except (ValueError, KeyError, OSError) as e:  # the codecs name the file too: name it once
+            detail = str(e).removeprefix(f"{p}: ")
+            raise DatasetError(f"{p}: unreadable {what}: {detail}") from None
 
     # --- views and cameras
     @property

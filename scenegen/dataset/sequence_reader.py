@@ -12,6 +12,7 @@ from scenegen.dataset.codecs import TrackSet, decode_flo, read_exr, read_json, r
 from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.layout import (
     SEQUENCE_INDEX,
+    check_listed_names,
     SEQUENCE_OBJECTS,
     motion_path,
     sequence_flow_path,
@@ -46,6 +47,13 @@ class SequenceIndex:
                    {t["stream"]: tuple(t["frames"]) for t in d["tracks"]},
                    tuple((p["a"], p["b"], int(p["step"])) for p in d.get("stereo_pairs", ())))
 
+    def check_names(self, source: str) -> None:
+        """Every view and stream name the index lists, checked before any reaches a path
+        (:func:`scenegen.dataset.layout.check_listed_names`); ValueError naming ``source``."""
+        views = [v for a, b, _ in self.pairs + self.stereo_pairs for v in (a, b)]
+        views += [v for frames in self.streams.values() for v in frames]
+        check_listed_names(source, views=views, names=[("stream", s) for s in self.streams])
+
 
 class SequenceTruth:
     """The sequence truth of one dataset; ``index`` is None for a static scene."""
@@ -59,9 +67,14 @@ class SequenceTruth:
         if self._index is None and self._ds.has(SEQUENCE_INDEX):
             doc = self._ds.read(SEQUENCE_INDEX, read_json, "sequence index")
             try:
-                self._index = SequenceIndex.from_dict(doc)
+                index = SequenceIndex.from_dict(doc)
             except (ValueError, KeyError, TypeError) as e:
                 raise DatasetError(f"{self._ds.path(SEQUENCE_INDEX)}: {e}") from None
+            try:  # once, where the index is read: every export and reader gets checked names
+                index.check_names(str(self._ds.path(SEQUENCE_INDEX)))
+            except ValueError as e:
+                raise DatasetError(str(e)) from None
+            self._index = index
         return self._index
 
     def object_poses(self, frame: int) -> dict[str, tuple[Rigid3, bool]]:

@@ -7,7 +7,7 @@ from pathlib import Path
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.files import atomic_write_bytes
 from scenegen.export.common import each, open_dataset
-from scenegen.export.sheet import compose, html_page, view_tiles
+from scenegen.export.sheet import check_sheet_size, check_tile_width, compose, html_page, view_tiles
 
 
 def default_png(out_dir) -> Path:
@@ -18,9 +18,9 @@ def default_png(out_dir) -> Path:
 def gallery(out_dir, png=None, *, max_width: int = 160, progress=None) -> dict:
     """Write the gallery of dataset ``out_dir``: ``png`` (default ``<OUT>.gallery.png`` next to
     the dataset) and the same name with ``.html``; returns {png, html, views}."""
-    if max_width < 16:
-        raise ValueError(f"--tile-width must be at least 16 pixels, got {max_width}")
+    check_tile_width(max_width)
     ds = open_dataset(out_dir)
+    check_sheet_size(max_width, [(c.width, c.height) for c in (ds.camera(v)[0] for v in ds.views)])
     png = Path(png) if png is not None else default_png(out_dir)
     rows, table = [], []
     for v in each(ds.views, progress):

@@ -24,6 +24,33 @@ KINDS = ("image", "depth", "normals", "ids")
 LABEL_PX = 18  # height of the text strip above each row
 MIN_DEPTH_SPAN = 0.05  # smallest colour-map span, as a fraction of the far depth
 GAP_PX = 2
+MIN_TILE_WIDTH_PX = 16
+#: Widest tile: four tiles side by side make a sheet at most 16,390 px wide, the image-side limit
+#: of a spec (MAX_IMAGE_SIDE_PX, 16,384, docs/scene_spec.md 'Limits') give or take the gaps.
+MAX_TILE_WIDTH_PX = 4096
+#: Most pixels of one sheet: 2^28 (768 MB of RGB while it is composed and encoded; the default
+#: 160 px tiles of 4:3 views fit 2,968 views). Checked before anything is rendered or read.
+MAX_SHEET_PIXELS = 1 << 28
+
+
+def check_tile_width(width: int) -> int:
+    """``width`` if it is a tile width from MIN_TILE_WIDTH_PX to MAX_TILE_WIDTH_PX; ValueError
+    naming ``--tile-width`` otherwise."""
+    if not MIN_TILE_WIDTH_PX <= width <= MAX_TILE_WIDTH_PX:
+        raise ValueError(f"--tile-width: expected {MIN_TILE_WIDTH_PX} to {MAX_TILE_WIDTH_PX:,} pixels (four tiles "
+                         f"make a sheet row), got {width:,}")
+    return width
+
+
+def check_sheet_size(width: int, sizes) -> tuple[int, int]:
+    """(width, height) in pixels of the sheet of views of ``sizes`` ((W, H) each) at tile ``width``,
+    computed before any tile is made; ValueError when it exceeds MAX_SHEET_PIXELS."""
+    sheet_w = len(KINDS) * width + GAP_PX * (len(KINDS) - 1)
+    sheet_h = sum(LABEL_PX + max(1, round(h * width / w)) + GAP_PX for w, h in sizes)
+    if sheet_w * sheet_h > MAX_SHEET_PIXELS:
+        raise ValueError(f"--tile-width {width}: the contact sheet of {len(sizes):,} views would be {sheet_w:,} x "
+                         f"{sheet_h:,} pixels, more than {MAX_SHEET_PIXELS:,}; give a smaller --tile-width")
+    return sheet_w, sheet_h
 
 
 def image_tile(image) -> np.ndarray:

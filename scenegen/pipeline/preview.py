@@ -17,12 +17,14 @@ from pathlib import Path
 
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.files import atomic_write_bytes
-from scenegen.export.sheet import compose, view_tiles
+from scenegen.export.sheet import check_sheet_size, check_tile_width, compose, view_tiles
 from scenegen.geometry.conventions import rescaled_opencv_pixels
 from scenegen.pipeline.progress import ViewProgress
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views
+from scenegen.spec.model import RenderSettings
+from scenegen.spec.parse.read import option_in_range
 
 
 def scaled_camera(cam, width: int):
@@ -45,14 +47,13 @@ def preview(spec_path, png=None, *, spp: int = 4, max_width: int = 160, variant:
             progress: bool = True) -> dict:
     """Render the contact sheet of every view of ``spec_path`` into ``png`` (default
     ``<spec>.preview.png``); returns {png, views, spp, seconds}."""
-    if spp < 1:
-        raise ValueError(f"--spp must be positive, got {spp}")
-    if max_width < 16:
-        raise ValueError(f"--tile-width must be at least 16 pixels, got {max_width}")
+    option_in_range(RenderSettings, "spp", spp, "--spp")
+    check_tile_width(max_width)
     t0 = time.perf_counter()
     spec = load_spec(spec_path)
     small = dataclasses.replace(spec, cameras={k: scaled_camera(c, max_width) for k, c in spec.cameras.items()})
     views = resolve_views(small)
+    check_sheet_size(max_width, [(small.cameras[v.camera].width, small.cameras[v.camera].height) for v in views])
     built = load_scene(small, variant=variant or small.render.variant, spp=spp)
     rows = []
     with ViewProgress(progress, len(views), label="preview") as bar:

@@ -23,7 +23,8 @@ from scenegen.pipeline.stages import run_stage
 from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
 from scenegen.spec import load_spec, resolve_views, spec_sha256, spec_to_dict
-from scenegen.spec.model import effective_spp
+from scenegen.spec.model import RenderSettings, effective_spp
+from scenegen.spec.parse.read import option_in_range
 from scenegen.spec.source import SpecSource
 from scenegen.spec.views import light_scales_dict
 
@@ -87,10 +88,8 @@ def render_spec(spec_path, out_dir, *, frames: str | None = None, spp: int | Non
     n_frames = 1 + max((v.frame_index for v in views), default=-1)
     wanted = parse_frames(frames, n_frames)
     rs = spec.render
-    spp = rs.spp if spp is None else int(spp)
-    seed = rs.seed if seed is None else int(seed)
-    if spp <= 0:
-        raise ValueError(f"--spp must be positive, got {spp}")
+    spp = rs.spp if spp is None else option_in_range(RenderSettings, "spp", int(spp), "--spp")
+    seed = rs.seed if seed is None else option_in_range(RenderSettings, "seed", int(seed), "--seed")
 
     t0 = time.perf_counter()
     built = load_scene(spec, variant=variant or rs.variant, spp=spp)

@@ -11,6 +11,8 @@ written when every view is complete.
 """
 from __future__ import annotations
 
+import warnings
+
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -124,6 +126,11 @@ def stream_tracks(st: SequenceTruth, vs, name: str, cfg) -> TrackSet:
         px = query_pixels(ids, np.isfinite(P[..., 0]), animated, n, hashed_seed32(cfg.seed, name, q))
         groups.append((P[px[:, 1], px[:, 0]], ids[px[:, 1], px[:, 0]], st.geometry(vs[q]), px[:, 1]))
         queries.append(np.column_stack([np.full(len(px), q), px[:, 1], px[:, 0]]))
+    got = sum(len(q) for q in queries)
+    if got < cfg.count:  # fewer surface pixels than asked for: said, not silent
+        warnings.warn(f"sequence.tracks.count: stream {name!r}: {got:,} of {cfg.count:,} tracks written; its query "
+                      f"frames {list(qs)} show only {got:,} surface pixels to start a track at", RuntimeWarning,
+                      stacklevel=2)
     xy, occ, oof = track_points(groups, frames)  # each frame's scene cast once for every query
     cam = st.built.cameras[vs[0].camera]
     return TrackSet(query_points=np.concatenate(queries), tracks_xy=xy, occluded=occ, out_of_frame=oof,

@@ -41,6 +41,8 @@ def correspond_in_kernel(scene, points_world, camera, cam_from_world: Rigid3,
     """:func:`scenegen.crossview.correspondence.correspond` of the truth points (H, W, 3) of view
     i (float32 as stored, or float64; NaN = no surface) in view j, in one kernel."""
     H, W = np.shape(points_world)[:2]
+    if H * W == 0:  # e.g. tracks of query frames without surface: Dr.Jit cannot mix width 0 with scalars
+        return Correspondence(np.zeros((H, W, 2)), np.zeros((H, W)), np.zeros((H, W), np.uint8))
     X, Y, Z = upload_points(points_world)
     o64 = lambda x: dr.opaque(mi.Float64, float(x))  # noqa: E731 (opaque: no recompilation per pose)
     R = [[o64(cam_from_world.R[i, j]) for j in range(3)] for i in range(3)]

@@ -12,8 +12,10 @@ import math
 import mitsuba as mi
 import numpy as np
 
+from scenegen.assets.envmap import check_envmap
 from scenegen.render.materials import rgb
 from scenegen.spec import model as m
+from scenegen.spec.assets_check import located
 
 
 def _area(light: m.AreaLight) -> dict:
@@ -41,6 +43,8 @@ def _constant(light: m.ConstantLight) -> dict:
 def _envmap(light: m.EnvmapLight) -> dict:
     # Mitsuba's envmap has +y up; ours is +z: rotate +y onto +z, then turn about +z.
     T = mi.ScalarTransform4f().rotate([0, 0, 1], light.rotation_z_deg) @ mi.ScalarTransform4f().rotate([1, 0, 0], 90)
+    with located(light, f"light {light.name!r}"):  # the size by its header before Mitsuba allocates it
+        check_envmap(light.path)
     return {"type": "envmap", "filename": str(light.path), "scale": float(light.scale), "to_world": T}
 
 

@@ -330,6 +330,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
 def to_yaml(spec: m.SceneSpec) -> str:
     """YAML text that :func:`scenegen.spec.parse_spec` (with the spec's ``base_dir``) turns back
     into the same spec."""
+    _check_is_spec(spec, "to_yaml")
     return yaml.safe_dump(spec_to_yaml_dict(spec), sort_keys=False, default_flow_style=None, width=100)
 
 
@@ -351,11 +352,18 @@ def _first_difference(a, b, path: str = "") -> str:
     return f"{path}: {a!r}, but the spec's rules give {b!r}"
 
 
+def _check_is_spec(spec, caller: str) -> None:
+    if not isinstance(spec, m.SceneSpec):
+        raise TypeError(f"{caller}(spec): expected a SceneSpec (from scenegen.api.Scene or load_spec), got "
+                        f"{type(spec).__name__} {spec!r:.60}")
+
+
 def check_spec(spec: m.SceneSpec) -> m.SceneSpec:
     """The spec validated exactly as its YAML would be: the parsed spec (with its ``warnings``),
     or a SpecError naming the field (``<python>: cameras.cam.fx: expected pixels > 0, got -1``).
     A value the parser would derive differently (an object_id that is not the object's position,
     fx given next to fov_deg) is an error naming it too."""
+    _check_is_spec(spec, "check_spec")
     try:
         text = to_yaml(spec)
     except (TypeError, ValueError, AttributeError) as e:

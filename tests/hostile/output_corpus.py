@@ -235,7 +235,7 @@ case("tracks_not_a_zip", "tracks", "pred.npz", BINARY, "not a readable pickle-fr
 case("tracks_truth_nan_where_visible", "tracks_truth", "truth.npz", npz_bytes({
     f"{k}.npy": npy_bytes(np.full_like(GOOD_TRACKS.tracks_xy, np.nan) if k == "tracks_xy" else getattr(GOOD_TRACKS, k))
     for k in TRACK_KEYS}),
-     "tracks: tracks_xy[0, 0] is not finite where the point is visible (expected finite pixel coordinates")
+     "tracks: tracks_xy: track 0 at frame 0 is visible (not occluded) but not finite")
 case("depth_npy_header_claims_74_gib", "depth", "d.npy", BOMB, "the header declares shape (20000000000,) of float32")
 case("depth_exr_truncated", "depth", "d.exr", TRUNCATED_EXR, "not a readable EXR file")
 case("depth_png_truncated", "depth", "d.png", TRUNCATED_PNG, "not a readable PNG")

@@ -3,6 +3,13 @@ fragment ``scenegen validate`` must print and the exit code. Generated from this
 stored as files; tests/hostile/test_hostile_spec_corpus.py runs every case through the CLI."""
 from __future__ import annotations
 
+import json
+
+import cv2
+import numpy as np
+
+from scenegen.dataset.codecs import pack_channels, write_exr
+
 BASE = """name: corpus
 render: {spp: 4, max_depth: 3, seed: 1}
 objects:
@@ -173,6 +180,41 @@ case("texture_checker_huge", sub("color: 0.5}", "texture: {type: checkerboard, p
 case("texture_size_negative", sub("color: 0.5}", "texture: {type: speckle, params: {size_px: -4}}}"), "must be positive")
 case("texture_size_text", sub("color: 0.5}", "texture: {type: natural, params: {size_px: big}}}"),
      "size_px must be an int")
+# --- environment maps: read as render reads them, the size by the header before allocation (issue 25)
+ENV = "  - {{type: envmap, path: {path}}}\n"
+for name, path, frag in [("text_exr", "text.exr", "not a readable EXR file"), ("empty_hdr", "empty.hdr", "the file is empty"),
+                         ("hdr_100000x1", "wide.hdr", "could not decode it"),
+                         ("hdr_100000x100000", "huge.hdr", "100000 x 100000 pixels by its header"),
+                         ("hdr_no_header", "noheader.hdr", "not a Radiance HDR file"),
+                         ("exr_nan", "nan.exr", "values are not finite"), ("exr_uv", "uv.exr", "expected channels R, G, B"),
+                         ("png_garbage", "corrupt.png", "not a readable PNG image"), ("tif", "env.tif", "expected a environment image file"),
+                         ("directory", "dir.exr", "is a directory"), ("ok_hdr", "ok.hdr", "OK"), ("ok_exr", "ok.exr", "OK")]:
+    case(f"envmap_{name}", sub("lights:\n", "lights:\n" + ENV.format(path=path)), frag, 0 if frag == "OK" else 2)
+# --- a mesh file's own materials and structure ------------------------------------------------------
+OWN = "  - name: thing\n    mesh: {path}\n"  # rendered with the file's own materials (no `material:`)
+case("mtl_texture_garbage_png", sub("lights:", OWN.format(path="mtl_bad.obj") + "lights:"), "could not decode it")
+case("mtl_texture_replaced_ok", sub("lights:", MESH.format(path="mtl_bad.obj") + "lights:"), "OK", 0)  # not read
+case("gltf_nested_100000", sub("lights:", MESH.format(path="deep.gltf") + "lights:"), "nested too deeply")
+case("gltf_node_chain_100000", sub("lights:", MESH.format(path="chain.gltf") + "lights:"),
+     "nodes are nested more than 1024 levels deep")
+case("gltf_node_cycle", sub("lights:", MESH.format(path="cycle.gltf") + "lights:"), "a node is its own ancestor")
+# --- sequences: what a sequence can give, and numbers derived from the spec's (issue 25) -------------
+SEQ_VIEWS = sub("    orbit: {center: [0, 0, 0], radius_m: 2.0, elevations_deg: [30], count: 3}",
+                "    trajectory: {keyframes: [{time_s: 0, eye: [0, -2, 1.5], target: [0, 0, 0]}]}")
+
+
+def sequence(section: str):
+    return lambda text: SEQ_VIEWS(text) + f"sequence: {section}\n"
+
+
+case("sequence_ok", sequence("{fps: 20, frames: 5, flow_steps: [1, 4], tracks: {count: 100}}"), "OK", 0)
+case("flow_steps_50", sequence("{fps: 20, frames: 5, flow_steps: [50]}"), "expected a step below 5")
+case("flow_steps_1e12", sequence("{fps: 20, frames: 5, flow_steps: [1, 1000000000000]}"), "flow_steps[1]: expected a step below 5")
+case("flow_steps_5", sequence("{fps: 20, frames: 5, flow_steps: [5]}"), "expected a step below 5")
+case("tracks_count_1e9", sequence("{fps: 20, frames: 5, tracks: {count: 1000000000}}"), "<= 1000000")
+case("tracks_count_pixels", sequence("{fps: 20, frames: 5, tracks: {count: 10000}}"), "expected at most 3,072 query points")
+case("fps_1e-320", sequence("{fps: 1e-320, frames: 5}"), "sequence.timestamps_s[1]: expected a finite number, got inf")
+case("start_s_overflow", sequence("{fps: 1e-308, frames: 5, start_s: 1.7e308}"), "expected a finite number, got inf")
 # --- sizes of the file itself ---------------------------------------------------------------------
 case("spec_50mb", append("# " + "x" * (50 * 2**20) + "\n"), "at most 1 MiB are read")
 case("spec_2mb_comment", append("# " + "x" * (2 * 2**20) + "\n"), "at most 1 MiB are read")
@@ -196,3 +238,29 @@ def write_assets(d) -> None:
     (d / "corrupt.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(200)))
     png = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x10\x00\x00\x00\x10\x08\x02\x00\x00\x00\x90\x91h6"
     (d / "truncated.png").write_bytes(png + b"\x00\x00\x01\x00IDAT")
+    hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n"
+    (d / "text.exr").write_text("hello, not an EXR file\n")
+    (d / "empty.hdr").write_bytes(b"")
+    (d / "wide.hdr").write_bytes(hdr + b"-Y 1 +X 100000\n" + bytes(16))
+    (d / "huge.hdr").write_bytes(hdr + b"-Y 100000 +X 100000\n" + bytes(16))
+    (d / "noheader.hdr").write_bytes(b"P6\n4 4\n255\n" + bytes(48))
+    (d / "env.tif").write_bytes(b"II*\x00")
+    (d / "dir.exr").mkdir(exist_ok=True)
+    rgb = np.linspace(0, 1, 8 * 16 * 3, dtype=np.float32).reshape(8, 16, 3)
+    assert cv2.imwrite(str(d / "ok.hdr"), rgb)
+    write_exr(d / "ok.exr", pack_channels("", rgb, "RGB"))
+    write_exr(d / "uv.exr", pack_channels("", rgb[..., :2], "UV"))
+    rgb[3, 4, 1] = np.nan
+    write_exr(d / "nan.exr", pack_channels("", rgb, "RGB"))
+    (d / "mtl_bad.obj").write_text("mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                   "usemtl a\nf 1/1 2/2 3/3\n")
+    (d / "bad.mtl").write_text("newmtl a\nKd 1 1 1\nmap_Kd corrupt.png\n")
+    (d / "deep.gltf").write_text('{"asset": {"version": "2.0"}, "extras": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    tri = {"meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+           "bufferViews": [{"buffer": 0, "byteLength": 36}],
+           "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + "A" * 48}]}
+    chain = [{"children": [i + 1]} for i in range(99_999)] + [{"mesh": 0}]
+    for name, nodes in [("chain", chain), ("cycle", [{"children": [1], "mesh": 0}, {"children": [0]}])]:
+        (d / f"{name}.gltf").write_text(json.dumps({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+                                                    "nodes": nodes, **tri}))

@@ -15,7 +15,7 @@ from hostile_data import run_cli  # noqa: E402
 from spec_corpus import BASE, sub  # noqa: E402
 
 from scenegen import located_yaml  # noqa: E402
-from scenegen.assets import checks  # noqa: E402
+from scenegen.assets import asset_refs, checks  # noqa: E402
 from scenegen.dataset import layout  # noqa: E402
 from scenegen.errors import SpecError  # noqa: E402
 from scenegen.located_yaml import source  # noqa: E402
@@ -36,6 +36,7 @@ def test_a_spec_name_fits_a_dataset_file_name():
 @pytest.mark.parametrize("value,shown", [
     (limits.MAX_IMAGE_SIDE_PX, "16,384 px"), (limits.MAX_IMAGE_PIXELS, "67,108,864"), (limits.MAX_SPP, "65,536"),
     (limits.MAX_VIEWS, "1,000,000"), (limits.MAX_BOARD_SIDE, "512"), (checks.MAX_TEXTURE_PIXELS, "2^26"),
+    (limits.MAX_TRACKS, "1,000,000"), (asset_refs.MAX_GLTF_NODE_DEPTH, "1,024 levels"),
     (checks.MAX_MESH_FACES, "50,000,000"), (checks.MAX_MESH_FILE_BYTES, "4 GiB"),
     (located_yaml.MAX_NAME_LEN, "128 characters"), (source.MAX_SOURCE_BYTES, "1 MiB")])
 def test_every_limit_is_documented_with_its_value(value, shown):

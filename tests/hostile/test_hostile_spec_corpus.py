@@ -41,7 +41,9 @@ def test_hostile_spec(folder, cid, edit, fragment, code):
     seconds = time.perf_counter() - t0
     assert "Traceback" not in err and got == code, (got, err)
     if code == 2:
-        assert len(err.strip().splitlines()) == 1 and err.startswith(f"scenegen: error: {spec}"), err
+        # the spec's file:line first, or a mesh file's own (file:line of the name in it) then the spec's
+        assert len(err.strip().splitlines()) == 1 and (err.startswith(f"scenegen: error: {spec}")
+                                                       or f"(the mesh of {spec}:" in err), err
         assert fragment in err, err
     else:
         assert fragment in out

@@ -12,6 +12,7 @@ import numpy as np
 import OpenEXR
 
 from scenegen.dataset.files import atomic_write_bytes
+from scenegen.quiet import quiet_native_output
 
 _EXR_DTYPES = (np.dtype(np.float32), np.dtype(np.uint32))
 
@@ -55,28 +56,30 @@ def write_exr(path, channels: Mapping[str, np.ndarray]) -> None:
     atomic_write_bytes(path, encode_exr(channels))
 
 
-def _channels_of(f) -> dict[str, np.ndarray]:
-    return {name: np.ascontiguousarray(ch.pixels) for name, ch in f.channels().items()}
+def _read(source, what: str, header_only: bool = False):
+    """OpenEXR.File of ``source`` (a path or a stream) with its channels read, quietly
+    (:mod:`scenegen.quiet`); OpenEXR's errors (bare Exception/RuntimeError, also from the pixel data,
+    read lazily) become a ValueError naming ``what``."""
+    try:
+        with quiet_native_output():
+            f = OpenEXR.File(source, separate_channels=True, header_only=header_only)
+            channels = None if header_only else {name: np.ascontiguousarray(ch.pixels)
+                                                 for name, ch in f.channels().items()}
+    except Exception as e:  # OpenEXR raises bare Exception/RuntimeError on bad data
+        why = str(e).replace(f"'{source}'" if isinstance(source, str) else "'<python_buffer>'", "it")
+        raise ValueError(f"{what}not a readable EXR file ({why})") from None  # the path named once
+    return f, channels
 
 
 def decode_exr(data: bytes) -> dict[str, np.ndarray]:
     """Every channel of one-part EXR bytes: ``{name: (H, W) array}`` in the file's (alphabetical)
     order; FLOAT -> float32, UINT -> uint32 (HALF -> float16), values bit-exact."""
-    try:
-        f = OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True)
-    except Exception as e:  # OpenEXR raises a bare Exception/RuntimeError on bad data
-        raise ValueError(f"not a readable EXR file ({e})") from None
-    return _channels_of(f)
+    return _read(io.BytesIO(bytes(data)), "")[1]
 
 
 def read_exr(path) -> dict[str, np.ndarray]:
     """Every channel of a one-part EXR file (see :func:`decode_exr`)."""
-    path = Path(path)
-    try:
-        f = OpenEXR.File(str(path), separate_channels=True)
-    except Exception as e:  # OpenEXR raises a bare Exception/RuntimeError on bad files
-        raise ValueError(f"{path}: not a readable EXR file ({e})") from None
-    return _channels_of(f)
+    return _read(str(Path(path)), f"{Path(path)}: ")[1]
 
 
 def _components_for(n: int, components: Sequence[str] | None) -> tuple[str, ...]:

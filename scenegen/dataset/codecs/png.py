@@ -7,6 +7,7 @@ import cv2
 import numpy as np
 
 from scenegen.dataset.files import atomic_write_bytes, read_decoded
+from scenegen.quiet import decode_image
 
 _PNG_COMPRESSION = 3  # zlib level; any level is lossless, fixed so bytes don't follow cv2 defaults
 
@@ -29,7 +30,7 @@ def encode_png(img) -> bytes:
 
 def decode_png(data: bytes) -> np.ndarray:
     """Inverse of :func:`encode_png`: (H, W) or (H, W, 3) RGB, dtype as stored."""
-    img = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+    img = decode_image(data)
     if img is None:
         raise ValueError("not a readable PNG")
     if img.ndim == 3:

@@ -56,16 +56,28 @@ class TrackSet:
             if arrays[k].shape != shape or n < 0:
                 raise ValueError(f"tracks: {k} must have shape {shape} (N tracks, T frames), got "
                                  f"{arrays[k].shape}")
-        lost = ~arrays["occluded"] & ~np.all(np.isfinite(arrays["tracks_xy"]), axis=-1)
-        if lost.any():
-            i, t_ = np.argwhere(lost)[0]
-            raise ValueError(f"tracks: tracks_xy[{i}, {t_}] is not finite where the point is visible (expected finite "
-                             f"pixel coordinates wherever occluded is false; {int(lost.sum())} such entries)")
+        check_finite_where_visible(arrays["query_points"], arrays["tracks_xy"], arrays["occluded"])
         for k, v in arrays.items():
             object.__setattr__(self, k, v)
 
     def __len__(self) -> int:
         return len(self.query_points)
+
+
+def check_finite_where_visible(query_points: np.ndarray, tracks_xy: np.ndarray, occluded: np.ndarray) -> None:
+    """The rule every reader of tracks relies on (the exports, recon-eval's scoring): query points
+    are finite and a point marked visible has a finite position; ValueError naming the first
+    track and frame that breaks it. Written tracks always keep it (NaN only where a point does not
+    project, which is out of frame, so occluded)."""
+    bad_q = ~np.isfinite(query_points).all(axis=1)
+    if bad_q.any():
+        raise ValueError(f"tracks: query_points: track {int(np.argmax(bad_q))} is not finite "
+                         f"({int(bad_q.sum())} such tracks)")
+    bad = ~np.isfinite(tracks_xy).all(axis=2) & ~occluded
+    if bad.any():
+        n, t = (int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"tracks: tracks_xy: track {n} at frame {t} is visible (not occluded) but not "
+                         f"finite ({int(bad.sum())} such points): expected finite pixel positions")
 
 
 def encode_tracks(tracks: TrackSet) -> bytes:

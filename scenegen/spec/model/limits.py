@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from scenegen.assets.checks import MAX_MESH_FACES, MAX_MESH_FILE_BYTES, MAX_TEXTURE_PIXELS
 
-__all__ = ["MAX_IMAGE_SIDE_PX", "MAX_IMAGE_PIXELS", "MAX_SPP", "MAX_VIEWS", "MAX_BOARD_SIDE", "MAX_MESH_FACES",
-           "MAX_MESH_FILE_BYTES", "MAX_TEXTURE_PIXELS"]
+__all__ = ["MAX_IMAGE_SIDE_PX", "MAX_IMAGE_PIXELS", "MAX_SPP", "MAX_VIEWS", "MAX_BOARD_SIDE", "MAX_TRACKS",
+           "MAX_MESH_FACES", "MAX_MESH_FILE_BYTES", "MAX_TEXTURE_PIXELS"]
 
 #: Largest image side, pixels. Why: Mitsuba's film and our per-pixel truth are dense arrays of
 #: the image; 16384 is the largest side of common sensors and displays times two, and the largest
@@ -29,5 +29,10 @@ MAX_VIEWS = 1_000_000
 #: rasterised with every edge on a texel boundary; 512 squares of the smallest raster already
 #: make a texture at the image-size limit.
 MAX_BOARD_SIDE = 512
+#: Most point tracks of one camera stream (``sequence.tracks.count``). Why: each track is every
+#: frame's position (two float32) and two flags, 10 bytes a frame, and is cast through every
+#: frame's scene: a million tracks over 100 frames are 1 GB of truth; each query point is also a
+#: distinct surface pixel of a query frame, so more than the image holds cannot be drawn.
+MAX_TRACKS = 1_000_000
 #: The asset limits (mesh triangles and file bytes, texture pixels) live with the asset builders
 #: that check them: scenegen.assets.checks (MAX_MESH_FACES, MAX_MESH_FILE_BYTES, MAX_TEXTURE_PIXELS).

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.trajectory import INTERPOLATIONS, JOINT_TYPES, JointTrajectory, KeyframeTrajectory
+from scenegen.spec.model.limits import MAX_TRACKS
 from scenegen.spec.model.meta import SEED_MAX, param, part, where_field
 
 _S = "seconds"
@@ -79,7 +80,7 @@ class Animation:
 class TrackSpec:
     """Long point tracks (TAP-Vid style) per camera stream of a sequence."""
 
-    count: int = param(256, unit="query points per stream", lo=1)  # split between the query frames,
+    count: int = param(256, unit="query points per stream", lo=1, hi=MAX_TRACKS)  # split between the query frames,
     # half on moving objects where any is seen
     query_frames: tuple[int, ...] = param((0,), unit="frame indices of the stream", lo=0)
     seed: int = param(0, unit="seed", label="", lo=0, hi=SEED_MAX,
@@ -97,6 +98,6 @@ class SequenceSpec:
     timestamps_s: tuple[float, ...] = param(unit=_S, derived="start_s + k / fps")  # or explicit,
     # strictly increasing
     flow_steps: tuple[int, ...] = param((1,), unit="frames", lo=1)  # flow, scene flow and
-    # occlusion truth for frames (k, k + step) of each stream, both ways
+    # occlusion truth for frames (k, k + step) of each stream, both ways; each below the frame count
     tracks: TrackSpec | None = part(None, unit="point tracks; None = none")
     where: Where | None = where_field()

@@ -1,9 +1,9 @@
 """``lights:``: area, point, spot, constant (environment) and envmap lights."""
 from __future__ import annotations
 
+from scenegen.assets.checks import ENVMAP_SUFFIXES
 from scenegen.located_yaml import Node
 from scenegen.spec.model import lights as ml
-from scenegen.spec.model.materials import IMAGE_SUFFIXES
 from scenegen.spec.model.meta import WORLD_UP
 from scenegen.spec.model.views import LookAt
 from scenegen.spec.parse.context import ParseContext
@@ -40,7 +40,7 @@ def parse_light(node: Node, index: int, ctx: ParseContext) -> ml.Light:
     if kind == "constant":
         return C(name=name, where=w, radiance=read_color(f.get("radiance"), C, "radiance"))
     if kind == "envmap":
-        path, written = f.get("path").as_path(IMAGE_SUFFIXES, "environment image")
+        path, written = f.get("path").as_path(ENVMAP_SUFFIXES, "environment image")
         return C(name=name, path=path, path_as_written=written, scale=read_float(f, C, "scale"),
                  rotation_z_deg=read_float(f, C, "rotation_z_deg"), where=w)
     if kind == "spot":

@@ -46,6 +46,21 @@ def bounds(fi: FieldInfo, *, opens: bool = True) -> dict:
     return kw
 
 
+def option_in_range(cls: type, name: str, value: int, option: str) -> int:
+    """``value`` of a command-line option that stands for spec field ``name`` of ``cls`` (``--spp``
+    for ``render.spp``), held to the field's own range (the spec's limits, e.g. MAX_SPP), so an
+    option cannot ask for what the spec may not; ValueError naming the option otherwise."""
+    m = field_info(cls, name).meta
+    bad_lo = m.lo is not None and (value <= m.lo if m.lo_open else value < m.lo)
+    bad_hi = m.hi is not None and (value >= m.hi if m.hi_open else value > m.hi)
+    if bad_lo or bad_hi:
+        parts = [f"{op} {bound:,}" for op, bound in ((">" if m.lo_open else ">=", m.lo),
+                                                     ("<" if m.hi_open else "<=", m.hi)) if bound is not None]
+        raise ValueError(f"{option}: expected a whole number {' and '.join(parts)} ({m.unit}; the spec's "
+                         f"limit, docs/scene_spec.md), got {value:,}")
+    return value
+
+
 def read_float(f: Fields, cls: type, name: str, key: str | None = None, *, default: Any = _UNSET,
                **override) -> float | None:
     """A number; ``override`` replaces range bounds that depend on other values."""

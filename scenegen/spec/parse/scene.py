@@ -8,6 +8,7 @@ from typing import Callable
 
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Fields, Node
+from scenegen.spec.finite import check_finite
 from scenegen.spec.model.limits import MAX_VIEWS
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.model.scene import SceneSpec
@@ -51,6 +52,7 @@ def parse_document(doc: Document) -> SceneSpec:
     ctx = ctx.but(cameras=frozen_mapping(named_section(f, "cameras", parse_camera, ctx)))
     ctx = ctx.but(rigs=frozen_mapping(named_section(f, "rigs", parse_rig, ctx)))
     sequence = parse_sequence(f.get("sequence"), ctx) if "sequence" in f else None
+    check_finite(sequence)  # the clock before the views and objects timed by it: named at its source
     ctx = ctx.but(sequence=sequence)
     objects = []  # one by one: a parent is named before its children
     for i, item in enumerate(f.get("objects").items("a list of objects") if "objects" in f else []):
@@ -70,6 +72,7 @@ def parse_document(doc: Document) -> SceneSpec:
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
         rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
         warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence)
+    check_finite(spec)  # derived numbers too (k / fps): nothing infinite reaches the renderer or the JSON
     views = resolve_views(spec)  # degenerate placements are errors now, not at render time
     if sequence is not None:
         check_sequence(f, spec)

@@ -50,6 +50,11 @@ def parse_sequence(node: Node, ctx: ParseContext) -> mt.SequenceSpec:
                 raise items[k].error(f"expected strictly increasing timestamps, got {times[k]:g} "
                                      f"after {times[k - 1]:g}")
     steps = tuple(_whole(f.get("flow_steps"), s) for s in read_floats(f, S, "flow_steps", None))
+    for k, step in enumerate(steps):  # a step of the frame count or more pairs no frames
+        if step >= len(times):
+            raise f.get("flow_steps").items()[k].error(
+                f"expected a step below {len(times)} (the sequence's frames), got {step}: no frame pair "
+                f"(k, k + {step}) exists")
     tracks = parse_tracks(f.get("tracks"), len(times), ctx) if "tracks" in f else None
     return S(fps=fps, frames=n, start_s=start, timestamps_s=times, flow_steps=steps, tracks=tracks,
              where=node.where)
@@ -71,7 +76,12 @@ def parse_tracks(node: Node, n_frames: int, ctx: ParseContext) -> mt.TrackSpec:
             raise (f.get("query_frames").items()[k] if "query_frames" in f else node).error(
                 f"expected a frame index below {n_frames} (the sequence's frames), got {x}")
     seed = seed_or_none(f, T)
-    return T(count=read_int(f, T, "count"), query_frames=q,
+    count = read_int(f, T, "count")
+    pixels = max((c.width * c.height for c in ctx.cameras.values()), default=0)
+    if "count" in f and pixels and count > len(q) * pixels:  # each query point: a distinct pixel of its frame
+        raise f.get("count").error(f"expected at most {len(q) * pixels:,} query points: each is a distinct pixel "
+                                   f"of one of {len(q)} query frame(s) of at most {pixels:,} pixels, got {count:,}")
+    return T(count=count, query_frames=q,
              seed=ctx.seed_for(node.path) if seed is None else seed, where=node.where)
 
 

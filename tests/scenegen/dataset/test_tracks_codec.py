@@ -55,12 +55,18 @@ def test_bad_input_is_refused_with_the_key_named(tmp_path):
         tracks_path("../x")
 
 
-def test_a_visible_point_must_be_finite_occluded_ones_may_be_nan():
+def test_a_visible_point_must_be_finite_on_every_read_and_write():
+    """The rule the exports and recon-eval's scoring share (issue 25: all-NaN truth tracks were
+    exported with exit 0 while recon-eval refused them): NaN only where the point is occluded."""
     tr = _tracks()
     xy = tr.tracks_xy.copy()
-    xy[tr.occluded] = np.nan  # where it does not project: allowed when occluded
-    TrackSet(tr.query_points, xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)
-    i, t = np.argwhere(~tr.occluded)[0]
-    xy[i, t, 1] = np.inf
-    with pytest.raises(ValueError, match=rf"tracks_xy\[{i}, {t}\] is not finite where the point is visible"):
+    xy[tr.occluded] = np.nan  # allowed: not visible
+    assert len(TrackSet(tr.query_points, xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)) == 5
+    n, t = np.argwhere(~tr.occluded)[0]
+    xy[n, t, 0] = np.nan
+    with pytest.raises(ValueError, match=f"track {n} at frame {t} is visible \\(not occluded\\) but not finite"):
         TrackSet(tr.query_points, xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)
+    q = tr.query_points.copy()
+    q[2, 1] = np.inf
+    with pytest.raises(ValueError, match="query_points: track 2 is not finite"):
+        TrackSet(q, tr.tracks_xy, tr.occluded, tr.out_of_frame, tr.image_size, tr.frame_names)

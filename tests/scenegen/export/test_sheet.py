@@ -3,7 +3,13 @@ normals as (n + 1) / 2, one fixed colour per instance id, rows laid out as docum
 import cv2
 import numpy as np
 
-from scenegen.export.sheet import GAP_PX, LABEL_PX, compose, depth_tile, id_colours, normals_tile
+import pytest
+
+from scenegen.export.sheet import (
+    GAP_PX, KINDS, LABEL_PX, MAX_SHEET_PIXELS, MAX_TILE_WIDTH_PX, check_sheet_size, check_tile_width, compose,
+    depth_tile, id_colours, normals_tile, resized, view_tiles,
+)
+from scenegen.spec.model.limits import MAX_IMAGE_SIDE_PX
 
 
 def test_depth_colours_span_the_views_range():
@@ -31,3 +37,22 @@ def test_rows_are_laid_out_as_documented():
     tiles = [np.zeros((10, 16, 3), np.uint8)] * 4
     sheet = compose([("a", tiles), ("b", tiles)])
     assert sheet.shape == (2 * (LABEL_PX + 10 + GAP_PX), 4 * 16 + 3 * GAP_PX, 3)
+
+
+def test_the_sheet_size_is_known_before_any_tile_is_made():
+    """check_sheet_size computes what compose makes (so the limit is checked before rendering or
+    reading anything), and the limits hold: the widest sheet is about the spec's image side."""
+    sizes = [(64, 48), (33, 77), (640, 10)]
+    truth = lambda w, h: {"valid": np.ones((h, w), bool), "depth_z": np.ones((h, w)),  # noqa: E731
+                          "normals_cam": np.zeros((h, w, 3)), "instance_id": np.zeros((h, w), np.uint32)}
+    rows = [(f"v{i}", view_tiles(np.zeros((h, w, 3), np.uint8), truth(w, h), 50)[0]) for i, (w, h) in enumerate(sizes)]
+    assert check_sheet_size(50, sizes) == compose(rows).shape[1::-1]
+    assert len(KINDS) * MAX_TILE_WIDTH_PX + 3 * GAP_PX - MAX_IMAGE_SIDE_PX < 16
+    assert check_tile_width(16) == 16 and check_tile_width(MAX_TILE_WIDTH_PX) == MAX_TILE_WIDTH_PX
+    for bad in (15, MAX_TILE_WIDTH_PX + 1, 10**8):
+        with pytest.raises(ValueError, match="--tile-width: expected 16 to 4,096 pixels"):
+            check_tile_width(bad)
+    views = MAX_SHEET_PIXELS // ((len(KINDS) * 160 + 3 * GAP_PX) * (LABEL_PX + 120 + GAP_PX)) + 1
+    with pytest.raises(ValueError, match=f"the contact sheet of {views:,} views would be"):
+        check_sheet_size(160, [(640, 480)] * views)
+    assert resized(np.zeros((48, 64, 3), np.uint8), 160).shape[:2] == (120, 160)
