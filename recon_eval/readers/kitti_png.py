@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
-from recon_eval.readers.native import quiet_native_output, read_png
+from recon_eval.readers.native import read_png
 from scenegen.dataset.codecs import decode_kitti_disparity, encode_kitti_disparity
 from scenegen.dataset.files import atomic_write_bytes
 
@@ -19,8 +19,7 @@ def read_kitti_disparity(path) -> np.ndarray:
     if not p.is_file():
         raise InputError(f"{p}: no such file (expected a KITTI uint16 disparity PNG)")
     try:
-        with quiet_native_output():  # libpng's own messages
-            d, valid = decode_kitti_disparity(p.read_bytes())
+        d, valid = decode_kitti_disparity(p.read_bytes())  # quietly (scenegen.quiet)
     except ValueError as exc:  # not a PNG, or not single-channel uint16
         raise InputError(f"{p}: {exc} (expected a KITTI uint16 disparity PNG)") from None
     d[~valid] = np.nan
