@@ -61,7 +61,8 @@ def _thresh(name: str) -> float:
     return USAC_THRESH_PX if name.startswith("usac") else THRESH_PX.get(name, 1.0)
 
 
-def _fit_f(flag: str, x1, x2):
+def fit_opencv_f(flag: str, x1, x2):
+    """cv2.findFundamentalMat with the flag's method and this module's thresholds: (F or None, mask or None)."""
     if flag in ("7point", "8point"):
         F, mask = cv2.findFundamentalMat(x1, x2, _flag(flag))
     else:
@@ -103,7 +104,7 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
                 pick = np.random.default_rng(SEVEN_POINT_SEED).choice(np.flatnonzero(use), 7, replace=False)
                 use = np.zeros(n, bool)
                 use[pick] = True
-            F, mask = _fit_f(flag, x1[use], x2[use]) if fit is None else fit(i, j, kind, x1[use], x2[use])
+            F, mask = fit_opencv_f(flag, x1[use], x2[use]) if fit is None else fit(i, j, kind, x1[use], x2[use])
             if flag == "7point" and F is not None and len(F) > 3:  # up to 3 solutions: keep the one with
                 sols = np.asarray(F).reshape(-1, 3, 3)  # the lowest median Sampson on the labelled inliers
                 F = min(sols, key=lambda G: float(np.median(sampson_sq_px2(G, x1[true_inl], x2[true_inl]))))

@@ -82,8 +82,9 @@ def denormalise(Fn, T1, T2) -> np.ndarray:
 
 
 def smallest_right_vector(A) -> np.ndarray:
-    """Unit f minimising |A f| (the last right singular vector; H&Z A5.3)."""
-    return np.linalg.svd(A, full_matrices=True)[2][-1]
+    """Unit f minimising |A f| (the last right singular vector; H&Z A5.3). The thin SVD when A has
+    at least as many rows as columns (the full one of a tall A builds an N x N U)."""
+    return np.linalg.svd(A, full_matrices=A.shape[0] < A.shape[1])[2][-1]
 
 
 def solve_f33(A, w=None) -> np.ndarray | None:
