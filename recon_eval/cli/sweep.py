@@ -11,10 +11,9 @@ from pathlib import Path
 from recon_eval.cli.registry import Impl
 from recon_eval.errors import InputError
 from recon_eval.readers.scenegen_dataset import read_dataset
-from recon_eval.report import plots
 from recon_eval.report.document import document, write_json_atomic
-from recon_eval.report.html import Figure, render_html, write_html_atomic
-from recon_eval.report.sweep_tables import breakdown_table, markdown
+from recon_eval.report.html import render_html, write_html_atomic
+from recon_eval.report.sweep_report import breakdown_table, figures, markdown
 from recon_eval.runners.common import RunOutput
 from recon_eval.runners.declared import external_method, load_methods
 from recon_eval.runners.external import TIMEOUT_S
@@ -25,8 +24,6 @@ from scenegen.dataset.files import atomic_write_bytes
 
 #: Truth correspondences the trials are drawn from (seeded sample of the pair's dense truth).
 TRUTH_POOL = 20000
-#: Errors above this (px) are drawn at it in the plots.
-PLOT_CEILING_PX = 1000.0
 
 
 def arguments(p) -> None:
@@ -51,31 +48,6 @@ def arguments(p) -> None:
     p.add_argument("--timeout", type=float, default=TIMEOUT_S, metavar="S", help="--command: seconds per trial")
     p.add_argument("--markdown", metavar="OUT.md", help="also write the tables as Markdown")
     p.add_argument("--quiet", action="store_true")
-
-
-def _figures(results: dict) -> list[Figure]:
-    cells, cfg = results["cells"], results["config"]
-    fam = {c["method"]: c["family"] for c in cells}
-
-    def panels(fixed_key, fixed, axis, value_key):
-        out: dict = {}
-        for m, f in fam.items():
-            row = {c[axis]: float(c[value_key]) for c in cells if c["method"] == m and c[fixed_key] == fixed}
-            out.setdefault(f, {})[m.removeprefix("survey-f-")] = [row[v] for v in sorted(row)]
-        return out
-
-    sig, fr = sorted(cfg["sigmas_px"]), sorted(cfg["outlier_fractions"])
-    figs = [Figure("Error against noise", plots.panels_figure(
-        sig, panels("outlier_fraction", fr[0], "sigma_px", "epi_mean_px"), xlabel="sigma (px)",
-        ylabel="mean distance to epipolar line (px)", title=f"{fr[0]:.0%} outliers", ceiling=PLOT_CEILING_PX),
-        "mean over the trials of the truth points' distances to the estimated epipolar lines; open markers: failed "
-        f"or above {PLOT_CEILING_PX:g} px")]
-    for s in sig:
-        figs.append(Figure(f"Error against outliers, sigma {s:g} px", plots.panels_figure(
-            fr, panels("sigma_px", s, "outlier_fraction", "median_trial_epi_px"), xlabel="outlier fraction",
-            ylabel="median trial distance (px)", title=f"sigma {s:g} px", ceiling=PLOT_CEILING_PX,
-            hline=cfg["breakdown_px"]), f"dashed: the breakdown threshold {cfg['breakdown_px']:g} px"))
-    return figs
 
 
 def run(a) -> int:
@@ -110,7 +82,7 @@ def run(a) -> int:
     write_json_atomic(out / "sweep.json", doc)
     html_results = {f"{c['method']}.sigma_{c['sigma_px']:g}.outliers_{c['outlier_fraction']:g}":
                     {k: v for k, v in c.items() if k not in ("trials", "method", "family")} for c in doc["results"]["cells"]}
-    write_html_atomic(out / "report.html", render_html("sweep", inputs, html_results, _figures(doc["results"])))
+    write_html_atomic(out / "report.html", render_html("sweep", inputs, html_results, figures(doc["results"])))
     if a.markdown:
         atomic_write_bytes(a.markdown, (markdown(doc["results"]) + "\n").encode("utf-8"))
     if not a.quiet:

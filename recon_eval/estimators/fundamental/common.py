@@ -66,8 +66,14 @@ def apply_t(T, x) -> np.ndarray:
 
 def design(x1, x2) -> np.ndarray:
     """(N, 9) rows kron(x2h, x1h) (H&Z eq. 11.3), f row-major."""
-    a, b = homog(x1), homog(x2)
-    return (b[:, :, None] * a[:, None, :]).reshape(len(a), 9)
+    return design_rows(x1, x2)
+
+
+def design_rows(x1, x2) -> np.ndarray:
+    """(..., N, 9) design rows of (..., N, 2) points (batches of samples too)."""
+    ones = np.ones(x1.shape[:-1] + (1,))
+    a, b = np.concatenate([x1, ones], axis=-1), np.concatenate([x2, ones], axis=-1)
+    return (b[..., :, None] * a[..., None, :]).reshape(x1.shape[:-1] + (9,))
 
 
 def normalised(x1, x2):

@@ -24,11 +24,16 @@ import math
 
 import numpy as np
 
-from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, failed, homog, normalised,
+from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, design_rows, failed, homog,
+                                                     normalised,
                                                      sampson_distance, tidy)
 from recon_eval.estimators.fundamental.linear import cubic_solutions, eight_point_eigen, eight_point_ls
 
 SAMPLE = 7
+#: Minimal samples solved together (vectorised); the result does not depend on it.
+BATCH = 64
+#: (c3, c2, c1, c0) of a cubic from its values at 0, 1, -1, 2.
+_INV_VANDER = np.linalg.inv(np.vander(np.array([0.0, 1.0, -1.0, 2.0]), 4))
 #: EM passes for MLESAC's mixing parameter.
 EM_PASSES = 5
 
@@ -43,30 +48,69 @@ def _iterations_for(inlier_ratio: float, confidence: float, max_iter: int) -> in
     return min(max_iter, max(1, math.ceil(math.log(1 - confidence) / math.log(1 - p))))
 
 
+def _batch_hypotheses(x1n, x2n, picks) -> list[tuple[int, np.ndarray]]:
+    """(sample index, normalised F) of every real root of a batch of minimal samples (B, 7), in
+    sample order: :func:`.linear.cubic_solutions` vectorised (batched SVD, the cubic's four
+    determinants, its companion matrix's eigenvalues as ``numpy.roots`` computes them); a sample
+    whose cubic has no cubic term goes through :func:`.linear.cubic_solutions` itself."""
+    Vt = np.linalg.svd(design_rows(x1n[picks], x2n[picks]), full_matrices=True)[2]  # (B, 9, 9)
+    F1, F2 = Vt[:, -1].reshape(-1, 3, 3), Vt[:, -2].reshape(-1, 3, 3)
+    t = np.array([0.0, 1.0, -1.0, 2.0])[None, :, None, None]
+    dets = np.linalg.det(t * F1[:, None] + (1 - t) * F2[:, None])  # (B, 4)
+    c = dets @ _INV_VANDER.T  # (B, 4): c3, c2, c1, c0
+    out = []
+    degenerate = np.abs(c[:, 0]) <= 1e-12 * np.max(np.abs(c), axis=1)
+    comp = np.zeros((len(c), 3, 3))
+    comp[:, 0, :] = -c[:, 1:] / np.where(degenerate, 1.0, c[:, 0])[:, None]
+    comp[:, 1, 0] = comp[:, 2, 1] = 1.0
+    roots = np.linalg.eigvals(comp)
+    for b in range(len(c)):
+        if degenerate[b]:
+            out += [(b, F) for F in cubic_solutions(x1n[picks[b]], x2n[picks[b]])]
+            continue
+        for r in roots[b]:
+            if abs(r.imag) <= 1e-8 * max(1.0, abs(r.real)):
+                out.append((b, r.real * F1[b] + (1 - r.real) * F2[b]))
+    return out
+
+
 def _search(x1, x2, score, seed: int, confidence: float, max_iter: int, adaptive) -> tuple:
-    """(best F or None, its score, samples drawn): the hypothesis of least ``score(d)``;
-    ``adaptive(d)`` the inlier ratio that sets the number of samples, or None (fixed count).
-    The points are normalised once (the seven-point solutions do not depend on the frame)."""
+    """(best F or None, its score, samples drawn): the hypothesis of least ``score(d2)`` (d2: (H, N)
+    squared Sampson distances of H hypotheses, scores (H,)), the first of equals; ``adaptive(d2)``
+    the inlier ratios (H,) that set the number of samples, or None (a fixed count). Samples are
+    drawn one by one (``rng.choice``) and solved in batches of :data:`BATCH`, taken in order up to
+    the count needed. The points are normalised once (the seven-point solutions do not depend on
+    the frame)."""
     rng = np.random.default_rng(seed)
     n = len(x1)
     x1n, x2n, T1, T2 = normalised(x1, x2)
     a, b = homog(x1), homog(x2)
-    best, best_score, needed, k = None, np.inf, max_iter if adaptive else _iterations_for(0.5, confidence, max_iter), 0
+    best, best_score, k = None, np.inf, 0
+    needed = max_iter if adaptive else _iterations_for(0.5, confidence, max_iter)
     while k < needed:
-        k += 1
-        pick = rng.choice(n, SAMPLE, replace=False)
-        for Fn in cubic_solutions(x1n[pick], x2n[pick]):
-            F = T2.T @ Fn @ T1
-            Fa, Ftb = a @ F.T, b @ F
+        picks = np.array([rng.choice(n, SAMPLE, replace=False) for _ in range(min(BATCH, needed - k))])
+        hyps = _batch_hypotheses(x1n, x2n, picks)
+        if hyps:
+            Fs = np.einsum("ji,bjk,kl->bil", T2, np.array([F for _, F in hyps]), T1)  # T2^T Fn T1
+            Fa, Ftb = np.einsum("bij,nj->bni", Fs, a), np.einsum("bji,nj->bni", Fs, b)
+            r = np.einsum("ni,bni->bn", b, Fa)
             with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.abs(np.sum(b * Fa, axis=1)) / np.sqrt(Fa[:, 0] ** 2 + Fa[:, 1] ** 2 + Ftb[:, 0] ** 2
-                                                             + Ftb[:, 1] ** 2)
-            d = np.where(np.isfinite(d), d, np.inf)
-            s = score(d)
-            if s < best_score:
-                best, best_score = tidy(F), s
+                d2 = r ** 2 / (Fa[..., 0] ** 2 + Fa[..., 1] ** 2 + Ftb[..., 0] ** 2 + Ftb[..., 1] ** 2)
+            d2 = np.where(np.isfinite(d2), d2, np.inf)
+            scores = score(d2)
+            ratios = adaptive(d2) if adaptive else None
+        done, current = len(picks), -1
+        for h, (s_idx, _) in enumerate(hyps):
+            if s_idx != current:  # a new sample: drawn only if the count so far still needed it
+                current = s_idx
+                if k + s_idx >= needed:
+                    done = s_idx
+                    break
+            if scores[h] < best_score:
+                best, best_score = tidy(Fs[h]), float(scores[h])
                 if adaptive:
-                    needed = min(needed, _iterations_for(adaptive(d), confidence, max_iter))
+                    needed = min(needed, _iterations_for(float(ratios[h]), confidence, max_iter))
+        k += done
     return best, best_score, k
 
 
@@ -79,7 +123,7 @@ def _refit(x1, x2, inl, fit, extra) -> Estimate:
 
 def _lmeds(x1, x2, seed, confidence, max_iter, fit):
     x1, x2 = check_points(x1, x2, 8)
-    F, med, k = _search(x1, x2, lambda d: float(np.median(d ** 2)), seed, confidence, max_iter, None)
+    F, med, k = _search(x1, x2, lambda d2: np.median(d2, axis=1), seed, confidence, max_iter, None)
     if F is None:
         return failed(len(x1), "no hypothesis")
     sigma = max(1.4826 * (1 + 5.0 / (len(x1) - SAMPLE)) * math.sqrt(med), SIGMA_FLOOR_PX)
@@ -101,8 +145,9 @@ def ransac(x1, x2, *, seed: int = 0, threshold_px: float = 1.0, confidence: floa
            max_iter: int = 5000) -> Estimate:
     """RANSAC: most Sampson distances below ``threshold_px``."""
     x1, x2 = check_points(x1, x2, 8)
-    F, s, k = _search(x1, x2, lambda d: -float(np.count_nonzero(d < threshold_px)), seed, confidence, max_iter,
-                      lambda d: np.count_nonzero(d < threshold_px) / len(d))
+    t2 = threshold_px ** 2
+    F, s, k = _search(x1, x2, lambda d2: -np.count_nonzero(d2 < t2, axis=1).astype(float), seed, confidence,
+                      max_iter, lambda d2: np.count_nonzero(d2 < t2, axis=1) / d2.shape[1])
     if F is None:
         return failed(len(x1), "no hypothesis")
     inl = sampson_distance(F, x1, x2) < threshold_px
@@ -114,17 +159,17 @@ def _diagonal(x2) -> float:
     return float(max(np.hypot(*span), 1.0))
 
 
-def mixture_nll(d, sigma: float, v: float) -> tuple[float, float, np.ndarray]:
-    """(negative log-likelihood, gamma, inlier posteriors (N,)) of distances d under
-    gamma N(0, sigma^2) + (1 - gamma) / v, gamma by EM from 0.5 (Torr and Zisserman 2000, eq. 8-9)."""
-    g_in = np.exp(-0.5 * (d / sigma) ** 2) / (math.sqrt(2 * math.pi) * sigma)
-    gamma = 0.5
+def mixture_nll(d2, sigma: float, v: float):
+    """(negative log-likelihood, gamma, inlier posteriors) of squared distances d2 (N,) or (H, N)
+    under gamma N(0, sigma^2) + (1 - gamma) / v, gamma by EM from 0.5 (Torr and Zisserman 2000,
+    eq. 8-9); per row for (H, N)."""
+    g_in = np.exp(-0.5 * d2 / sigma ** 2) / (math.sqrt(2 * math.pi) * sigma)
+    gamma = np.full(g_in.shape[:-1] + (1,), 0.5)
     for _ in range(EM_PASSES):
         p_in = gamma * g_in
-        post = p_in / (p_in + (1 - gamma) / v)
-        gamma = float(np.mean(post))
+        gamma = np.mean(p_in / (p_in + (1 - gamma) / v), axis=-1, keepdims=True)
     like = gamma * g_in + (1 - gamma) / v
-    return float(-np.sum(np.log(like))), gamma, gamma * g_in / like
+    return -np.sum(np.log(like), axis=-1), gamma[..., 0], gamma * g_in / like
 
 
 def mlesac(x1, x2, *, seed: int = 0, sigma_px: float = 1.0, confidence: float = 0.999,
@@ -132,12 +177,12 @@ def mlesac(x1, x2, *, seed: int = 0, sigma_px: float = 1.0, confidence: float = 
     """MLESAC: the least mixture negative log-likelihood (module docstring)."""
     x1, x2 = check_points(x1, x2, 8)
     v = _diagonal(x2)
-    F, nll, k = _search(x1, x2, lambda d: mixture_nll(d, sigma_px, v)[0], seed, confidence, max_iter,
-                        lambda d: mixture_nll(d, sigma_px, v)[1])
+    F, nll, k = _search(x1, x2, lambda d2: mixture_nll(d2, sigma_px, v)[0], seed, confidence, max_iter,
+                        lambda d2: mixture_nll(d2, sigma_px, v)[1])
     if F is None:
         return failed(len(x1), "no hypothesis")
-    _, gamma, post = mixture_nll(sampson_distance(F, x1, x2), sigma_px, v)
-    return _refit(x1, x2, post > 0.5, eight_point_eigen, {"samples": k, "gamma": gamma, "nll": nll, "v_px": v})
+    _, gamma, post = mixture_nll(sampson_distance(F, x1, x2) ** 2, sigma_px, v)
+    return _refit(x1, x2, post > 0.5, eight_point_eigen, {"samples": k, "gamma": float(gamma), "nll": nll, "v_px": v})
 
 
 def mapsac_threshold(sigma_px: float, v: float, gamma: float = 0.5) -> float:
@@ -150,8 +195,8 @@ def mapsac(x1, x2, *, seed: int = 0, sigma_px: float = 1.0, confidence: float = 
     """MAPSAC: the least sum of min(d^2 / sigma^2, T) (module docstring)."""
     x1, x2 = check_points(x1, x2, 8)
     T = mapsac_threshold(sigma_px, _diagonal(x2))
-    F, s, k = _search(x1, x2, lambda d: float(np.sum(np.minimum((d / sigma_px) ** 2, T))), seed, confidence,
-                      max_iter, lambda d: float(np.mean((d / sigma_px) ** 2 < T)))
+    F, s, k = _search(x1, x2, lambda d2: np.sum(np.minimum(d2 / sigma_px ** 2, T), axis=1), seed, confidence,
+                      max_iter, lambda d2: np.mean(d2 / sigma_px ** 2 < T, axis=1))
     if F is None:
         return failed(len(x1), "no hypothesis")
     inl = (sampson_distance(F, x1, x2) / sigma_px) ** 2 < T

@@ -1,9 +1,16 @@
-"""Markdown tables of a sweep's results (``recon-eval sweep --markdown``; docs/fmatrix_survey.md):
-the mean and standard deviation of the point-to-epipolar-line distance per method and cell, and
-the breakdown points."""
+"""A sweep's report (``recon-eval sweep``; docs/fmatrix_survey.md): the figures of error against
+noise and against outliers per method family, and the Markdown tables (``--markdown``) of the mean
+and standard deviation of the point-to-epipolar-line distance per method and cell and of the
+breakdown points."""
 from __future__ import annotations
 
 import math
+
+from recon_eval.report import plots
+from recon_eval.report.html import Figure
+
+#: Errors above this (px) are drawn at it in the plots.
+PLOT_CEILING_PX = 1000.0
 
 
 def _px(v) -> str:
@@ -66,3 +73,30 @@ def markdown(results: dict) -> str:
         parts += [f"Mean ± std (px) of the truth points' distances to the epipolar lines, {f:.0%} outliers:", "",
                   cells_table(results, outlier_fraction=f), ""]
     return "\n".join(parts)
+
+
+def figures(results: dict) -> list[Figure]:
+    """Error against noise (no outliers), and against the outlier fraction at each sigma, one panel per
+    method family."""
+    cells, cfg = results["cells"], results["config"]
+    fam = {c["method"]: c["family"] for c in cells}
+
+    def panels(fixed_key, fixed, axis, value_key):
+        out: dict = {}
+        for m, f in fam.items():
+            row = {c[axis]: float(c[value_key]) for c in cells if c["method"] == m and c[fixed_key] == fixed}
+            out.setdefault(f, {})[m.removeprefix("survey-f-")] = [row[v] for v in sorted(row)]
+        return out
+
+    sig, fr = sorted(cfg["sigmas_px"]), sorted(cfg["outlier_fractions"])
+    figs = [Figure("Error against noise", plots.panels_figure(
+        sig, panels("outlier_fraction", fr[0], "sigma_px", "epi_mean_px"), xlabel="sigma (px)",
+        ylabel="mean distance to epipolar line (px)", title=f"{fr[0]:.0%} outliers", ceiling=PLOT_CEILING_PX),
+        "mean over the trials of the truth points' distances to the estimated epipolar lines; open markers: failed "
+        f"or above {PLOT_CEILING_PX:g} px")]
+    for s in sig:
+        figs.append(Figure(f"Error against outliers, sigma {s:g} px", plots.panels_figure(
+            fr, panels("sigma_px", s, "outlier_fraction", "median_trial_epi_px"), xlabel="outlier fraction",
+            ylabel="median trial distance (px)", title=f"sigma {s:g} px", ceiling=PLOT_CEILING_PX,
+            hline=cfg["breakdown_px"]), f"dashed: the breakdown threshold {cfg['breakdown_px']:g} px"))
+    return figs
