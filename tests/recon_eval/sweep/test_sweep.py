@@ -13,6 +13,7 @@ import pytest
 from recon_eval.errors import InputError
 from recon_eval.metrics.epipolar import epipolar_line_distances_px
 from recon_eval.runners.common import RunOutput
+from recon_eval.runners.declared import external_method
 from recon_eval.sweep.draw import draw_trial
 from recon_eval.sweep.methods import resolve
 from recon_eval.sweep.run import SweepConfig, run_sweep
@@ -174,3 +175,13 @@ def test_cli_sweep_bad_input_exits_2(plane_dataset, tmp_path):
     assert r.returncode == 2 and "{matches}" in r.stderr and "Traceback" not in r.stderr
     r = _sweep_cli(root, tmp_path / "o", "--methods", "opencv-f-7point")
     assert r.returncode == 2 and "exactly seven points" in r.stderr
+
+
+def test_a_failing_command_is_a_failed_trial_never_dropped(truth, tmp_path):
+    m = external_method("crashes", "fmatrix", '{python} -c "import sys; sys.exit(3)" {matches} {out}')
+    notes = RunOutput()
+    res = run_sweep(truth, resolve(["crashes"], {"crashes": m}, notes), SweepConfig((0.5,), (0.0,), 2, 30, 0, 1.0),
+                    tmp_path)
+    (cell,) = res["cells"]
+    assert cell["n_failed"] == 2 and cell["success_rate"] == 0 and cell["median_trial_epi_px"] == float("inf")
+    assert len(cell["trials"]) == 2 and all(n["failed"] == "exit status 3" for n in notes.notes.values())
