@@ -20,6 +20,11 @@ def _px(v) -> str:
     return f"{v:.3g}" if v < 1000 else f"{v:.0f}"
 
 
+def _entry(c) -> str:
+    mean = _px(c["epi_mean_px"])
+    return mean if mean == "fail" else f"{mean} ± {_px(c['epi_std_px'])}"
+
+
 def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None) -> str:
     """Rows: methods; columns: the swept sigmas at ``outlier_fraction`` (or the fractions at
     ``sigma_px``); each entry ``mean ± std`` px of the distances to the epipolar lines."""
@@ -39,7 +44,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None) -> str:
         fam = next(c["family"] for c in cells if c["method"] == m)
         vals = [by.get((m, v)) for v in cols]
         lines.append(f"| `{m}` | {fam} | " + " | ".join(
-            "" if c is None else f"{_px(c['epi_mean_px'])} ± {_px(c['epi_std_px'])}" for c in vals) + " |")
+            "" if c is None else _entry(c) for c in vals) + " |")
     return "\n".join(lines)
 
 
