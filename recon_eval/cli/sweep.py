@@ -36,7 +36,7 @@ def arguments(p) -> None:
                    help="outlier fractions in [0, 1) (default 0 0.1 0.2 0.3 0.4 0.5)")
     p.add_argument("--trials", type=int, default=5, help="trials per cell (default 5)")
     p.add_argument("--points", type=int, default=200, help="correspondences per trial (default 200)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="the seed of every trial and method (default 0)")
     p.add_argument("--breakdown-px", type=float, default=1.0,
                    help="median trial error (px) above which a method has broken down (default 1)")
     p.add_argument("--methods", nargs="+", metavar="NAME",
@@ -47,7 +47,7 @@ def arguments(p) -> None:
     p.add_argument("--name", default="external", help="--command: its name (default external)")
     p.add_argument("--timeout", type=float, default=TIMEOUT_S, metavar="S", help="--command: seconds per trial")
     p.add_argument("--markdown", metavar="OUT.md", help="also write the tables as Markdown")
-    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="print no progress and no table")
 
 
 def run(a) -> int:
