@@ -37,8 +37,8 @@ def arguments(p) -> None:
     p.add_argument("--trials", type=int, default=5, help="trials per cell (default 5)")
     p.add_argument("--points", type=int, default=200, help="correspondences per trial (default 200)")
     p.add_argument("--seed", type=int, default=0, help="the seed of every trial and method (default 0)")
-    p.add_argument("--breakdown-px", type=float, default=1.0,
-                   help="median trial error (px) above which a method has broken down (default 1)")
+    p.add_argument("--breakdown-px", type=float, default=2.0,
+                   help="median trial error (px) above which a method has broken down (default 2)")
     p.add_argument("--methods", nargs="+", metavar="NAME",
                    help="survey-f-<name>, opencv-f-<flag>, or your methods (default: the survey's nineteen)")
     p.add_argument("--methods-file", metavar="METHODS.yaml", help="your methods (kind fmatrix with {matches})")

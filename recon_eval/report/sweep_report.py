@@ -17,7 +17,7 @@ def _px(v) -> str:
     v = float(v) if not isinstance(v, str) else float(v)  # JSON writes inf as "inf"
     if not math.isfinite(v):
         return "fail"
-    return f"{v:.3g}" if v < 1000 else f"{v:.0f}"
+    return f"{v:.3g}"
 
 
 def _entry(c) -> str:

@@ -77,28 +77,32 @@ def _setup(x1, x2):
     return x1, U, _covariances(x1n, x2n, T1[0, 0], T2[0, 0]), T1, T2
 
 
-def _iterate(theta, step_matrix):
-    converged = False
-    k = 0
+def _iterate(theta, step_matrix, cost):
+    """(theta, iterations, converged): the fixed point of theta -> the eigenvector of
+    ``step_matrix(theta)`` closest to zero; if the iteration does not settle within MAX_ITER (or
+    diverges to a non-finite matrix: outliers), the iterate of least ``cost`` met, the start
+    included (the schemes minimise that cost; the estimate is never worse than where it began)."""
+    best, best_cost = theta, cost(theta)
     for k in range(1, MAX_ITER + 1):
         M = step_matrix(theta)
-        if not np.all(np.isfinite(M)):  # diverged (outliers): keep the last finite iterate
-            break
+        if not np.all(np.isfinite(M)):
+            return best, k, False
         new = _closest_to_zero(M)
         new = new if new @ theta >= 0 else -new
         moved = np.linalg.norm(new - theta)
         theta = new
         if moved < THETA_TOL:
-            converged = True
-            break
-    return theta, k, converged
+            return theta, k, True
+        c = cost(theta)
+        if c < best_cost:
+            best, best_cost = theta, c
+    return best, MAX_ITER, False
 
 
 def fns_theta(x1, x2) -> tuple[np.ndarray, int, bool, float]:
     """(unconstrained pixel F (3, 3) unit norm, iterations, converged, J_AML px^2) of FNS."""
     x1, U, B, T1, T2 = _setup(x1, x2)
-    theta = smallest_right_vector(U)
-    theta, k, ok = _iterate(theta, lambda t: x_matrix(t, U, B)[0])
+    theta, k, ok = _iterate(smallest_right_vector(U), lambda t: x_matrix(t, U, B)[0], lambda t: x_matrix(t, U, B)[1])
     J = x_matrix(theta, U, B)[1]
     return tidy(denormalise(theta.reshape(3, 3), T1, T2)), k, ok, J
 
@@ -106,7 +110,7 @@ def fns_theta(x1, x2) -> tuple[np.ndarray, int, bool, float]:
 def fns(x1, x2) -> Estimate:
     """FNS (module docstring), then the rank-2 projection."""
     x1, U, B, T1, T2 = _setup(x1, x2)
-    theta, k, ok = _iterate(smallest_right_vector(U), lambda t: x_matrix(t, U, B)[0])
+    theta, k, ok = _iterate(smallest_right_vector(U), lambda t: x_matrix(t, U, B)[0], lambda t: x_matrix(t, U, B)[1])
     J = x_matrix(theta, U, B)[1]
     F = tidy(denormalise(enforce_rank2(theta.reshape(3, 3)), T1, T2))
     return Estimate(F, np.ones(len(x1), bool), k, ok,
@@ -136,11 +140,12 @@ def _z_matrix(theta, U, B):
 def cfns(x1, x2) -> Estimate:
     """CFNS (module docstring): F of rank 2 minimising the Sampson cost."""
     x1, U, B, T1, T2 = _setup(x1, x2)
-    theta, _, _ = _iterate(smallest_right_vector(U), lambda t: x_matrix(t, U, B)[0])
-    theta = enforce_rank2(theta.reshape(3, 3)).ravel()
-    theta /= np.linalg.norm(theta)
-    theta, k, ok = _iterate(theta, lambda t: _z_matrix(t, U, B))
+    J_of = lambda t: x_matrix(t, U, B)[1]  # noqa: E731
+    theta, _, _ = _iterate(smallest_right_vector(U), lambda t: x_matrix(t, U, B)[0], J_of)
+    rank2 = lambda t: enforce_rank2(t.reshape(3, 3)).ravel() / np.linalg.norm(t)  # noqa: E731
+    theta, k, ok = _iterate(rank2(theta), lambda t: _z_matrix(t, U, B), lambda t: J_of(rank2(t)))
     J = x_matrix(theta, U, B)[1]
-    F = tidy(denormalise(theta.reshape(3, 3), T1, T2))
+    # at convergence det F ~ 1e-17 |F|^3 and the projection changes nothing; otherwise it keeps F of rank 2
+    F = tidy(denormalise(enforce_rank2(theta.reshape(3, 3)), T1, T2))
     sv = np.linalg.svd(theta.reshape(3, 3), compute_uv=False)
     return Estimate(F, np.ones(len(x1), bool), k, ok, {"aml_cost_px2": J, "det_ratio": float(sv[2] / sv[0])})
