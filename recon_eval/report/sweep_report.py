@@ -25,9 +25,10 @@ def _entry(c) -> str:
     return mean if mean == "fail" else f"{mean} ± {_px(c['epi_std_px'])}"
 
 
-def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None) -> str:
+def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str | None = None) -> str:
     """Rows: methods; columns: the swept sigmas at ``outlier_fraction`` (or the fractions at
-    ``sigma_px``); each entry ``mean ± std`` px of the distances to the epipolar lines."""
+    ``sigma_px``); each entry ``mean ± std`` px of the distances to the epipolar lines, or the
+    cell's ``key`` (e.g. ``pose_err_deg``) when given."""
     cells = results["cells"]
     if outlier_fraction is not None:
         cells = [c for c in cells if c["outlier_fraction"] == outlier_fraction]
@@ -44,7 +45,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None) -> str:
         fam = next(c["family"] for c in cells if c["method"] == m)
         vals = [by.get((m, v)) for v in cols]
         lines.append(f"| `{m}` | {fam} | " + " | ".join(
-            "" if c is None else _entry(c) for c in vals) + " |")
+            "" if c is None else (_entry(c) if key is None else _px(c[key])) for c in vals) + " |")
     return "\n".join(lines)
 
 
@@ -77,6 +78,9 @@ def markdown(results: dict) -> str:
     for f in cfg["outlier_fractions"]:
         parts += [f"Mean ± std (px) of the truth points' distances to the epipolar lines, {f:.0%} outliers:", "",
                   cells_table(results, outlier_fraction=f), ""]
+    for f in cfg["outlier_fractions"]:
+        parts += [f"Median over the trials of the pose error through the truth K (deg), {f:.0%} outliers:", "",
+                  cells_table(results, outlier_fraction=f, key="pose_err_deg"), ""]
     return "\n".join(parts)
 
 

@@ -14,7 +14,7 @@ def _results():
         for s, (e0, e1) in errs.items():
             for f, e in ((0.0, e0), (0.4, e1)):
                 cells.append({"method": m, "family": fam, "sigma_px": s, "outlier_fraction": f, "epi_mean_px": e,
-                              "epi_std_px": e / 2, "median_trial_epi_px": e})
+                              "epi_std_px": e / 2, "median_trial_epi_px": e, "pose_err_deg": 10 * e})
     cells[-1]["epi_mean_px"] = math.inf  # a failed cell reads "fail"
     cfg = {"sigmas_px": [0.0, 1.0], "outlier_fractions": [0.0, 0.4], "breakdown_px": 1.0}
     return {"config": cfg, "cells": cells, "breakdown": breakdown_points(cells, 1.0)}
@@ -27,7 +27,8 @@ def test_tables_state_mean_std_and_breakdown():
     assert "| `survey-f-ransac` | robust | 0.3 ± 0.15 | fail |" in cells_table(r, sigma_px=1.0)
     b = breakdown_table(r)
     assert "| `survey-f-fns` | iterative | 40% | 40% |" in b and "| `survey-f-ransac` | robust | > 40% | > 40% |" in b
-    assert markdown(r).count("|---|---|") == 3
+    assert "| `survey-f-fns` | iterative | 1 | 4 |" in cells_table(r, outlier_fraction=0.0, key="pose_err_deg")
+    assert markdown(r).count("|---|---|") == 5
 
 
 def test_figures_are_pngs_per_sigma():
