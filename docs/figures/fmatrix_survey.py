@@ -20,7 +20,8 @@ HERE = Path(__file__).resolve().parent
 def main(path: str, prefix: str = "fmatrix_survey") -> None:
     results = json.loads(Path(path).read_text())["results"]
     for fig in figures(results):
-        name = "noise" if fig.title == "Error against noise" else "outliers_" + fig.title.split()[-2].replace(".", "_") + "px"
+        sigma = fig.title.split()[-2].replace(".", "_")
+        name = "noise" if fig.title == "Error against noise" else f"outliers_{sigma}px"
         out = HERE / f"{prefix}_{name}.png"
         out.write_bytes(fig.png)
         print(f"wrote {out}", file=sys.stderr)

@@ -81,7 +81,8 @@ def run(a) -> int:
     doc = document("sweep", inputs, results)
     write_json_atomic(out / "sweep.json", doc)
     html_results = {f"{c['method']}.sigma_{c['sigma_px']:g}.outliers_{c['outlier_fraction']:g}":
-                    {k: v for k, v in c.items() if k not in ("trials", "method", "family")} for c in doc["results"]["cells"]}
+                    {k: v for k, v in c.items() if k not in ("trials", "method", "family")}
+                    for c in doc["results"]["cells"]}
     write_html_atomic(out / "report.html", render_html("sweep", inputs, html_results, figures(doc["results"])))
     if a.markdown:
         atomic_write_bytes(a.markdown, (markdown(doc["results"]) + "\n").encode("utf-8"))

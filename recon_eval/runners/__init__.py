@@ -3,8 +3,8 @@
 One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fisheye),
 :mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
 findHomography), :mod:`.fsurvey` (the nineteen F estimators of Armangue and Salvi's survey,
-:mod:`recon_eval.estimators.fundamental`), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
-SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
+:mod:`recon_eval.estimators.fundamental`), :mod:`.pnp` (solvePnP / solvePnPRansac),
+:mod:`.colmap` (pycolmap incremental SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
@@ -58,7 +58,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
          ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
-         ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix", ("external", "disparity"): "stereo disparity",
+         ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix",
+         ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
 
 

@@ -32,13 +32,15 @@ class SweepConfig:
             raise InputError(f"--sigmas: expected finite values >= 0 px, got {list(self.sigmas_px)}")
         if not self.outlier_fractions or any(not 0 <= f < 1 for f in self.outlier_fractions):
             raise InputError(f"--outliers: expected fractions in [0, 1), got {list(self.outlier_fractions)}")
-        if len(set(self.sigmas_px)) != len(self.sigmas_px) or len(set(self.outlier_fractions)) != len(self.outlier_fractions):
+        repeated = len(set(self.sigmas_px)) < len(self.sigmas_px)
+        if repeated or len(set(self.outlier_fractions)) < len(self.outlier_fractions):
             raise InputError("--sigmas / --outliers: a value is given twice")
         if self.trials < 1:
             raise InputError(f"--trials: expected >= 1, got {self.trials}")
         worst = max(self.outlier_fractions)
         if self.points - round(worst * self.points) < MIN_INLIERS:
-            raise InputError(f"--points {self.points} at outlier fraction {worst} keeps fewer than {MIN_INLIERS} inliers")
+            raise InputError(f"--points {self.points} at outlier fraction {worst} keeps fewer than {MIN_INLIERS} "
+                             "inliers")
         if not (math.isfinite(self.breakdown_px) and self.breakdown_px > 0):
             raise InputError(f"--breakdown-px: expected a number > 0, got {self.breakdown_px}")
         if not 0 <= self.seed < 2 ** 32:

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, denormalise, design, enforce_rank2,
+from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, denormalise, design,
+                                                     enforce_rank2,
                                                      normalised, sampson_terms, smallest_right_vector, solve_f33,
                                                      tidy)
 

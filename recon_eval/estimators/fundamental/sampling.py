@@ -24,7 +24,8 @@ import math
 
 import numpy as np
 
-from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, design_rows, failed, homog,
+from recon_eval.estimators.fundamental.common import (SIGMA_FLOOR_PX, Estimate, check_points, design_rows, failed,
+                                                     homog,
                                                      normalised,
                                                      sampson_distance, tidy)
 from recon_eval.estimators.fundamental.linear import cubic_solutions, eight_point_eigen, eight_point_ls
