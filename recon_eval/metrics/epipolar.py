@@ -282,7 +282,7 @@ def homography_summary(mace_px) -> HomographySummary:
 @dataclass(frozen=True)
 class EpipolarDistanceResult:
     """Distances of points to their epipolar lines, both images pooled (Armangue and Salvi,
-    "Overall view regarding fundamental matrix estimation", IVC 21(2), 2003, sec. 4: the mean and
+    "Overall view regarding fundamental matrix estimation", IVC 21(2), 2003: the mean and
     standard deviation of the distances between points and epipolar lines)."""
 
     mean_px: float  # mean of the 2N distances; inf if failed

@@ -1,6 +1,6 @@
 """Per-trial scores, per-cell statistics and breakdown points of a sweep (docs/fmatrix_survey.md).
 
-The survey's measure (Armangue and Salvi 2003, sec. 4) is taken against the TRUTH: the distances
+The survey's measure (Armangue and Salvi 2003) is taken against the TRUTH: the distances
 of the noise-free truth points t1, t2 of a trial's inlier rows to the epipolar lines of the
 estimated F (:func:`recon_eval.metrics.epipolar.epipolar_distance_stats`: t2 to F t1 and t1 to
 F^T t2, 2 n_in distances), so that it measures the estimate, not the noise. The same rows give

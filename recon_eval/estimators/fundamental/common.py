@@ -5,7 +5,7 @@ Convention (scenegen.geometry.twoview): ``x2^T F x1 = 0`` for (N, 2) undistorted
 image 1 and x2 of image 2; F is returned with unit Frobenius norm and ``F[2, 2] >= 0``.
 The vector ``f`` is F row-major, so the design row of a correspondence is
 ``kron(x2h, x1h) = (x2 x1, x2 y1, x2, y2 x1, y2 y1, y2, x1, y1, 1)`` (Hartley and Zisserman, 2nd
-ed., eq. 11.3).
+ed., sec. 11.1).
 """
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ def apply_t(T, x) -> np.ndarray:
 
 
 def design(x1, x2) -> np.ndarray:
-    """(N, 9) rows kron(x2h, x1h) (H&Z eq. 11.3), f row-major."""
+    """(N, 9) rows kron(x2h, x1h) (H&Z sec. 11.1), f row-major."""
     return design_rows(x1, x2)
 
 
@@ -88,7 +88,7 @@ def denormalise(Fn, T1, T2) -> np.ndarray:
 
 
 def smallest_right_vector(A) -> np.ndarray:
-    """Unit f minimising |A f| (the last right singular vector; H&Z A5.3). The thin SVD when A has
+    """Unit f minimising |A f| (the last right singular vector; H&Z appendix 5). The thin SVD when A has
     at least as many rows as columns (the full one of a tall A builds an N x N U)."""
     return np.linalg.svd(A, full_matrices=A.shape[0] < A.shape[1])[2][-1]
 
@@ -105,7 +105,7 @@ def solve_f33(A, w=None) -> np.ndarray | None:
 
 def enforce_rank2(F) -> np.ndarray:
     """The closest rank-2 matrix in Frobenius norm: smallest singular value set to 0 (H&Z sec.
-    11.1.1, eq. 11.2 / Alg. 11.1 (ii))."""
+    11.1.1, Alg. 11.1 (ii))."""
     U, s, Vt = np.linalg.svd(F)
     return U @ np.diag([s[0], s[1], 0.0]) @ Vt
 

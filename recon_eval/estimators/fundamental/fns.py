@@ -9,11 +9,11 @@ covariance of u_i propagated from the points' covariance Lambda (theta^T B_i the
     X_theta      = sum_i A_i / (theta^T B_i theta) - sum_i (theta^T A_i theta) / (theta^T B_i theta)^2 B_i,
 
 and the gradient of J_AML is 2 X_theta theta ("On the fitting of surfaces to data with
-covariances", PAMI 22(11), 2000, sec. 4).
+covariances", PAMI 22(11), 2000).
 
 * :func:`fns`: the fundamental numerical scheme: theta_{k+1} = the eigenvector of X_{theta_k}
   whose eigenvalue is closest to zero, from the normalised eight-point estimate, until theta
-  stops moving; the unconstrained minimiser is then projected to rank 2 (H&Z eq. 11.2), as the
+  stops moving; the unconstrained minimiser is then projected to rank 2 (H&Z sec. 11.1.1), as the
   survey does (the unconstrained F is kept in ``extra``).
 * :func:`cfns`: the constrained scheme ("A new approach to constrained parameter estimation
   applicable to some computer vision problems", Chojnacki et al. 2002, and IVC 22(2), 2004):

@@ -1,19 +1,19 @@
-"""The survey's iterative methods (Armangue and Salvi 2003, sec. 3.2) but FNS / CFNS
+"""The survey's iterative methods (Armangue and Salvi 2003) but FNS / CFNS
 (:mod:`.fns`), on Hartley-normalised points with every cost measured in pixels:
 
 * :func:`iterative_linear`: reweighted linear least squares whose weights make the algebraic
   residual r = x2^T F x1 the distances of the points to their epipolar lines in both images,
-  w^2 = 1 / |(F x1)_12|^2 + 1 / |(F^T x2)_12|^2 (Luong and Faugeras, IJCV 17(1), 1996, sec. 3.2;
-  Zhang, IJCV 27(2), 1998, sec. 4.2, eq. 10), eigen solution, F of the last pass projected to rank 2;
+  w^2 = 1 / |(F x1)_12|^2 + 1 / |(F^T x2)_12|^2 (Luong and Faugeras, IJCV 17(1), 1996;
+  Zhang, IJCV 27(2), 1998: the distances to the epipolar lines), eigen solution, F of the last pass projected to rank 2;
 * :func:`gradient_ls`, :func:`gradient_eigen`: reweighted by the gradient of r, w^2 = 1 / (|(F x1)_12|^2
-  + |(F^T x2)_12|^2), so that w^2 r^2 is the Sampson error (H&Z eq. 11.9; Zhang 1998 sec. 4.3,
-  eq. 12), solved with F33 = 1 (least squares) or |f| = 1 (eigen analysis);
+  + |(F^T x2)_12|^2), so that w^2 r^2 is the Sampson error (H&Z eq. 11.9; Zhang 1998: the gradient-weighted
+  criterion), solved with F33 = 1 (least squares) or |f| = 1 (eigen analysis);
 * :func:`newton_raphson`: the Sampson residuals e_i = r_i / sqrt(g_i) linearised at the current F
   (first-order Taylor expansion, the survey's Newton-Raphson, in its Gauss-Newton form with step
   halving) over the eight entries of f but its largest;
 * :func:`parameter_space`: minimisation over Luong and Faugeras's seven parameters (the two
   epipoles and three entries of the epipolar homography, so that F has rank 2 by construction;
-  Luong and Faugeras 1996 sec. 4.1, Zhang 1998 sec. 3.4, eq. 8, with the map chosen by the largest
+  Luong and Faugeras 1996; Zhang 1998, the parameterisation of F by its epipoles; the map chosen by the largest
   epipole coordinates) of the distances to the epipolar lines in both images, by
   ``scipy.optimize.least_squares`` (Levenberg-Marquardt).
 """

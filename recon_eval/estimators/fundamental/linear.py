@@ -1,12 +1,12 @@
-"""The survey's linear methods (Armangue and Salvi 2003, sec. 3.1), each on Hartley-normalised
+"""The survey's linear methods (Armangue and Salvi 2003), each on Hartley-normalised
 points (Hartley, "In defense of the eight-point algorithm", PAMI 19(6), 1997; H&Z Alg. 11.1):
 
 * :func:`seven_point`: the two-dimensional null space of the design matrix and the cubic
-  ``det(a F1 + (1 - a) F2) = 0`` (H&Z sec. 11.1.2, eq. 11.4); with more than seven points the null
+  ``det(a F1 + (1 - a) F2) = 0`` (H&Z sec. 11.1.2); with more than seven points the null
   space is the two smallest right singular vectors, and of the up to three real roots the one with
   the least Sampson error on the points is kept;
 * :func:`eight_point_ls`: "least squares": F33 = 1 and the other eight entries by linear least
-  squares, then the rank-2 projection (H&Z eq. 11.2);
+  squares, then the rank-2 projection (H&Z sec. 11.1.1);
 * :func:`eight_point_eigen`: "eigen analysis": |f| = 1, f the eigenvector of A^T A of the
   smallest eigenvalue (the last right singular vector of A, H&Z Alg. 11.1), then rank 2; the
   same method as OpenCV's ``FM_8POINT``;
@@ -89,7 +89,7 @@ def eight_point_eigen(x1, x2, w=None) -> Estimate:
 def rank2_algebraic(x1, x2) -> Estimate:
     """Linear estimate under the rank-2 constraint (H&Z Alg. 11.2 (i)-(iii), one pass): the
     epipole e of image 1 from the normalised eight-point F, then F = M [e]_x with f = E m,
-    E = kron(I, [e]_x^T), and m minimising |A E m| subject to |E m| = 1 (H&Z sec. A5.4.2)."""
+    E = kron(I, [e]_x^T), and m minimising |A E m| subject to |E m| = 1 (H&Z appendix 5, constrained least squares)."""
     x1, x2 = check_points(x1, x2, 8)
     x1n, x2n, T1, T2 = normalised(x1, x2)
     A = design(x1n, x2n)

@@ -1,15 +1,15 @@
-"""The survey's M-estimators (Armangue and Salvi 2003, sec. 3.3.1): iteratively reweighted least
+"""The survey's M-estimators (Armangue and Salvi 2003): iteratively reweighted least
 squares where each correspondence's row carries its Sampson normalisation 1 / g (H&Z eq. 11.9)
 times a robust weight w(d) of its Sampson distance d (px), with the scale sigma re-estimated each
 pass as the median absolute deviation about zero, sigma = 1.4826 median(d) (Rousseeuw and Leroy
-1987; Zhang, IJCV 27(2), 1998, sec. 5.1, eq. 22-25). Started from the normalised eight-point
+1987; Zhang, IJCV 27(2), 1998, M-estimators). Started from the normalised eight-point
 estimate on every correspondence (outliers included: an M-estimator has no sampling stage).
 
 * :func:`m_ls`, :func:`m_eigen`: Huber's weights, w = 1 for d <= k sigma, k sigma / d above,
-  k = :data:`HUBER_K` (Zhang 1998 table 1), solved with F33 = 1 (least squares) or |f| = 1
+  k = :data:`HUBER_K` (95 % efficiency at the Gaussian), solved with F33 = 1 (least squares) or |f| = 1
   (eigen analysis); inliers: d <= 2.5 sigma;
 * :func:`m_torr`: Torr and Murray's weights ("The development and comparison of robust methods for
-  estimating the fundamental matrix", IJCV 24(3), 1997, sec. 4.2): w = 1 for d < sigma,
+  estimating the fundamental matrix", IJCV 24(3), 1997): w = 1 for d < sigma,
   sigma / d for sigma <= d < 3 sigma, 0 beyond (inliers: w > 0), eigen analysis.
 """
 from __future__ import annotations

@@ -1,20 +1,20 @@
-"""The survey's random-sampling estimators (Armangue and Salvi 2003, sec. 3.3.2-3.3.3): hypotheses
+"""The survey's random-sampling estimators (Armangue and Salvi 2003): hypotheses
 from minimal samples of seven correspondences (:func:`.linear.cubic_solutions`, up to three
 each), each scored on every correspondence by its Sampson distance d (px, H&Z eq. 11.9); the best
 hypothesis's inliers are refitted with the normalised eight-point algorithm (H&Z Alg. 11.1, eigen
 analysis unless the method says least squares). Seeded: ``numpy.random.default_rng(seed)``.
 
 * :func:`lmeds_ls`, :func:`lmeds_eigen`: least median of squares (Rousseeuw 1984; Zhang, IJCV
-  27(2), 1998, sec. 5.2, eq. 26): the hypothesis of least median d^2, inliers
+  27(2), 1998, LMedS): the hypothesis of least median d^2, inliers
   d <= 2.5 sigma with sigma = 1.4826 (1 + 5 / (n - 7)) sqrt(median d^2); as many samples as give
   a clean one with probability ``confidence`` at 50 % outliers;
-* :func:`ransac`: Fischler and Bolles (CACM 24(6), 1981), H&Z Alg. 4.4: the most inliers
-  d < ``threshold_px``; samples adapted to the inlier ratio found (H&Z eq. 4.18);
-* :func:`mlesac`: Torr and Zisserman ("MLESAC", CVIU 78(1), 2000, sec. 3): the least negative
-  log-likelihood of the mixture gamma N(d; 0, sigma^2) + (1 - gamma) / v, gamma by EM (eq. 8-9),
+* :func:`ransac`: Fischler and Bolles (CACM 24(6), 1981), H&Z sec. 4.7: the most inliers
+  d < ``threshold_px``; samples adapted to the inlier ratio found (H&Z sec. 4.7.1);
+* :func:`mlesac`: Torr and Zisserman ("MLESAC", CVIU 78(1), 2000): the least negative
+  log-likelihood of the mixture gamma N(d; 0, sigma^2) + (1 - gamma) / v, gamma by EM,
   v the diagonal of image 2 (the range of d); inliers: posterior inlier probability > 0.5;
 * :func:`mapsac`: Torr ("Bayesian model estimation and selection for epipolar geometry and
-  generic manifold fitting", IJCV 50(1), 2002, sec. 5): the least sum of min(d^2 / sigma^2, T),
+  generic manifold fitting", IJCV 50(1), 2002): the least sum of min(d^2 / sigma^2, T),
   T = 2 log(gamma v / ((1 - gamma) sqrt(2 pi) sigma)) with gamma = 0.5 (the mixture's two terms
   at their crossing; F's model prior is the same for every hypothesis and drops out).
 """
@@ -40,7 +40,7 @@ EM_PASSES = 5
 
 
 def _iterations_for(inlier_ratio: float, confidence: float, max_iter: int) -> int:
-    """Samples for one all-inlier sample with probability ``confidence`` (H&Z eq. 4.18)."""
+    """Samples for one all-inlier sample with probability ``confidence`` (H&Z sec. 4.7.1)."""
     p = inlier_ratio ** SAMPLE
     if p >= 1.0:
         return 1
@@ -162,8 +162,8 @@ def _diagonal(x2) -> float:
 
 def mixture_nll(d2, sigma: float, v: float):
     """(negative log-likelihood, gamma, inlier posteriors) of squared distances d2 (N,) or (H, N)
-    under gamma N(0, sigma^2) + (1 - gamma) / v, gamma by EM from 0.5 (Torr and Zisserman 2000,
-    eq. 8-9); per row for (H, N)."""
+    under gamma N(0, sigma^2) + (1 - gamma) / v, gamma by EM from 0.5 (Torr and Zisserman
+    2000); per row for (H, N)."""
     g_in = np.exp(-0.5 * d2 / sigma ** 2) / (math.sqrt(2 * math.pi) * sigma)
     gamma = np.full(g_in.shape[:-1] + (1,), 0.5)
     for _ in range(EM_PASSES):
