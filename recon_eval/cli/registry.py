@@ -38,6 +38,9 @@ COMMANDS: tuple[Command, ...] = (
     Command("flow", "optical flow: EPE all/noc/occ, KITTI Fl bg/fg/all, Sintel s0-10/s10-40/s40+", "flow"),
     Command("tracks", "point tracks over a sequence: TAP-Vid AJ, < delta_avg, OA against the truth tracks", "tracks"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
+    Command("sweep", "F estimators over noise and outliers on exact truth: mean/std epipolar distance, breakdown",
+            "sweep", description="Sweep F estimators over Gaussian noise and outlier fractions drawn from DATASET's "
+                                 "exact truth of a view pair (docs/fmatrix_survey.md)."),
     Command("homography", "homography: mean corner error, accuracy and AUC", "twoview"),
     Command("calibration", "intrinsics: fx/fy/cx/cy errors, projection difference field, reprojection RMS", "camera"),
     Command("pnp", "absolute pose: rotation angle, translation error, reprojection RMS", "camera"),

@@ -276,3 +276,44 @@ def homography_summary(mace_px) -> HomographySummary:
     e = np.where(np.isnan(e), np.inf, e)
     acc = [float(np.mean(e <= t)) if len(e) else 0.0 for t in (1.0, 3.0, 5.0)]
     return HomographySummary(*acc, *recall_auc(e, (3.0, 5.0, 10.0)), len(e), int(np.sum(~np.isfinite(e))))
+
+
+# --- the survey's measure ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EpipolarDistanceResult:
+    """Distances of points to their epipolar lines, both images pooled (Armangue and Salvi,
+    "Overall view regarding fundamental matrix estimation", IVC 21(2), 2003: the mean and
+    standard deviation of the distances between points and epipolar lines)."""
+
+    mean_px: float  # mean of the 2N distances; inf if failed
+    std_px: float  # their standard deviation (population, ddof 0); inf if failed
+    n_points: int  # N correspondences (2N distances)
+    failed: bool
+    failure_reason: str | None
+
+
+def epipolar_line_distances_px(F, x1, x2) -> tuple[np.ndarray, np.ndarray]:
+    """(d1, d2) (N,) px: the distance of x1 to its epipolar line F^T x2 in image 1 and of x2 to
+    F x1 in image 2, for correspondences x1 -> x2 (N, 2); inf where a line is undefined."""
+    F = as_float_array(F, "F", (3, 3))
+    a = homogeneous(as_float_array(x1, "x1", (None, 2)))
+    b = homogeneous(as_float_array(x2, "x2", (None, 2)))
+    Fa, Ftb = a @ F.T, b @ F
+    r = np.abs(np.sum(b * Fa, axis=1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d1, d2 = r / np.hypot(Ftb[:, 0], Ftb[:, 1]), r / np.hypot(Fa[:, 0], Fa[:, 1])
+    return np.where(np.isfinite(d1), d1, np.inf), np.where(np.isfinite(d2), d2, np.inf)
+
+
+def epipolar_distance_stats(F_est, x1, x2) -> EpipolarDistanceResult:
+    """Mean and standard deviation of the 2N point-to-epipolar-line distances of correspondences
+    x1 <-> x2 (N, 2) px under ``F_est`` (:func:`epipolar_line_distances_px`); a degenerate F is a
+    failure (inf)."""
+    x1 = as_float_array(x1, "x1", (None, 2))
+    if len(x1) == 0:
+        raise InputError("correspondences: empty")
+    why = fundamental_degeneracy(F_est)
+    if why is not None:
+        return EpipolarDistanceResult(np.inf, np.inf, len(x1), True, why)
+    d = np.concatenate(epipolar_line_distances_px(F_est, x1, x2))
+    return EpipolarDistanceResult(float(np.mean(d)), float(np.std(d)), len(x1), False, None)

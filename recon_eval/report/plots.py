@@ -327,3 +327,31 @@ def metric_vs_figure(x, curves: dict, *, xlabel: str, ylabel: str, title: str, x
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _png(fig)
+
+
+def panels_figure(x, panels: dict, *, xlabel: str, ylabel: str, title: str, ceiling: float,
+                  hline: float | None = None) -> bytes:
+    """One log-y panel per group (a sweep's method families): ``panels`` group -> {label: (P,)
+    values} against ``x`` (P,); values above ``ceiling`` or not finite (a failure, a broken estimate)
+    are drawn at the ceiling with an open marker; ``hline`` a dashed threshold."""
+    plt = _plt()
+    x = np.asarray(x, float)
+    n = max(len(panels), 1)
+    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.8), sharey=True, squeeze=False)
+    for ax, (group, curves) in zip(axes[0], panels.items()):
+        for label, y in curves.items():
+            y = np.asarray(y, float)
+            over = ~(y <= ceiling)
+            line, = ax.plot(x, np.where(over, ceiling, y), "o-", ms=4, label=label)
+            if over.any():
+                ax.plot(x[over], np.full(over.sum(), ceiling), "o", mfc="white", mec=line.get_color(), ms=7)
+        if hline is not None:
+            ax.axhline(hline, color="k", ls="--", lw=1)
+        ax.set_yscale("log")
+        ax.set_title(group, fontsize=10)
+        ax.set_xlabel(xlabel)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    axes[0][0].set_ylabel(ylabel)
+    fig.suptitle(title, fontsize=11)
+    return _png(fig)

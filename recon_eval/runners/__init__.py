@@ -2,8 +2,9 @@
 
 One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fisheye),
 :mod:`.stereo` (StereoBM / StereoSGBM), :mod:`.twoview` (findFundamentalMat, findEssentialMat,
-findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
-SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
+findHomography), :mod:`.fsurvey` (the nineteen F estimators of Armangue and Salvi's survey,
+:mod:`recon_eval.estimators.fundamental`), :mod:`.pnp` (solvePnP / solvePnPRansac),
+:mod:`.colmap` (pycolmap incremental SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
@@ -26,6 +27,7 @@ from pathlib import Path
 import cv2
 
 from recon_eval.errors import InputError, NotApplicable
+from recon_eval.estimators.fundamental import ESTIMATORS as F_SURVEY
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report.document import document, to_jsonable, write_json_atomic
 from recon_eval.report.html import render_html, write_html_atomic
@@ -56,7 +58,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
          ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
-         ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
+         ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix",
+         ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
 
 
@@ -79,6 +82,8 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-stereo-sgbm", "stereo", "run", "cv2.StereoSGBM (3-way) on the rectified pairs", matcher="sgbm"),
     *[_m(f"opencv-f-{f.replace('_', '-')}", "twoview", "fundamental", f"cv2.findFundamentalMat {f}", flag=f)
       for f in _F],
+    *[_m(f"survey-f-{e.name}", "fsurvey", "fundamental", f"{e.label} ({e.cites}); numpy/scipy, Armangue and Salvi's "
+         f"survey (docs/fmatrix_survey.md)", estimator=e.name) for e in F_SURVEY.values()],
     _m("opencv-e-ransac", "twoview", "essential", "cv2.findEssentialMat RANSAC", flag="ransac"),
     _m("opencv-e-lmeds", "twoview", "essential", "cv2.findEssentialMat LMEDS", flag="lmeds"),
     _m("opencv-e-usac-magsac", "twoview", "essential", "cv2.findEssentialMat USAC_MAGSAC", flag="usac_magsac"),

@@ -61,7 +61,8 @@ def _thresh(name: str) -> float:
     return USAC_THRESH_PX if name.startswith("usac") else THRESH_PX.get(name, 1.0)
 
 
-def _fit_f(flag: str, x1, x2):
+def fit_opencv_f(flag: str, x1, x2):
+    """cv2.findFundamentalMat with the flag's method and this module's thresholds: (F or None, mask or None)."""
     if flag in ("7point", "8point"):
         F, mask = cv2.findFundamentalMat(x1, x2, _flag(flag))
     else:
@@ -74,8 +75,11 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
     """cv2.findFundamentalMat with ``options["flag"]`` on every match set of every pair (module
     docstring). ``transform_F`` maps the estimate before it is written (only
     :mod:`recon_eval.runners.faults` sets it). ``fit(i, j, kind, x1, x2) -> (F or None, mask or
-    None)`` replaces OpenCV (an external estimator, :mod:`recon_eval.runners.external`): it gets
-    every match of the set, undistorted; a None mask claims every match an inlier."""
+    None)`` replaces OpenCV (an external estimator, :mod:`recon_eval.runners.external`; the survey's
+    estimators, :mod:`recon_eval.runners.fsurvey`): it gets the matches the flag feeds (every match of
+    the set, undistorted; with flag 7point / 8point the labelled inliers as OpenCV's own), F may
+    stack several solutions (3k, 3) as OpenCV's 7-point does; a None mask claims every match given an
+    inlier."""
     flag = options.get("flag", "external")
     pairs = crossview_pairs(ds)
     out = RunOutput()
@@ -100,7 +104,7 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
                 pick = np.random.default_rng(SEVEN_POINT_SEED).choice(np.flatnonzero(use), 7, replace=False)
                 use = np.zeros(n, bool)
                 use[pick] = True
-            F, mask = _fit_f(flag, x1[use], x2[use]) if fit is None else fit(i, j, kind, x1, x2)
+            F, mask = fit_opencv_f(flag, x1[use], x2[use]) if fit is None else fit(i, j, kind, x1[use], x2[use])
             if flag == "7point" and F is not None and len(F) > 3:  # up to 3 solutions: keep the one with
                 sols = np.asarray(F).reshape(-1, 3, 3)  # the lowest median Sampson on the labelled inliers
                 F = min(sols, key=lambda G: float(np.median(sampson_sq_px2(G, x1[true_inl], x2[true_inl]))))
@@ -132,8 +136,8 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
                                 pre + "inlier_precision": ir.precision, pre + "pose_err_deg": pe.pose_err_deg})
             out.notes[f"{key}.matches"] = {"n": int(n), "used": int(use.sum()),
                                            "true_inliers": int(true_inl.sum()),
-                                           "threshold_px": None if flag in ("7point", "8point", "external")
-                                           else _thresh(flag)}
+                                           "threshold_px": _thresh(flag) if flag in THRESH_PX
+                                           or flag.startswith("usac") else None}
     if not out.raw_files:
         raise NotApplicable(f"{ds.root}: the cross-view pairs have no match sets (or only zero-baseline pairs)")
     return out

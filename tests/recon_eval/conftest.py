@@ -370,3 +370,26 @@ def flow_dataset(tmp_path_factory):
     """(path, {view: (Camera, cam_from_world)}) of the two-frame flow dataset (written once)."""
     root = tmp_path_factory.mktemp("flow") / "ds"
     return root, write_flow_dataset(root)
+
+
+# --- exact two-view correspondences of a non-planar point set (closed form, no dataset) ------------
+def _two_view_points(n: int = 100, seed: int = 0):
+    """(x1, x2 (n, 2) exact undistorted pixels, F_gt (3, 3) unit norm, K (3, 3), cam2_from_cam1):
+    points in a 1.6 x 1.2 x 1.0 m box seen by wide_baseline.yaml's two cameras (480 x 360, fx 400),
+    projected in float64: x2^T F_gt x1 = 0 to rounding."""
+    from scenegen.geometry.twoview import fundamental
+
+    rng = np.random.default_rng(seed)
+    K = np.array([[400.0, 0.0, 239.5], [0.0, 400.0, 179.5], [0.0, 0.0, 1.0]])
+    X = rng.uniform([-0.8, -0.6, -0.5], [0.8, 0.6, 0.5], (n, 3)) + [0.0, 0.3, 0.5]
+    p1 = look_at((-0.75, -1.45, 0.9), (0.0, 0.3, 0.5)).inverse()
+    p2 = look_at((0.75, -1.45, 0.9), (0.0, 0.3, 0.5)).inverse()
+    x1, x2 = (p.apply(X) @ K.T for p in (p1, p2))
+    rel = p2 @ p1.inverse()
+    return x1[:, :2] / x1[:, 2:], x2[:, :2] / x2[:, 2:], fundamental(K, K, rel), K, rel
+
+
+@pytest.fixture(scope="session")
+def two_view_points():
+    """``two_view_points(n=100, seed=0) -> (x1, x2, F_gt, K, cam2_from_cam1)``: exact correspondences."""
+    return _two_view_points

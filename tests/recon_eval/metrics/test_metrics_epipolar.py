@@ -4,6 +4,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from recon_eval.metrics.epipolar import (
+    epipolar_distance_stats,
+    epipolar_line_distances_px,
     fundamental_degeneracy,
     fundamental_metrics,
     homography_mace,
@@ -142,3 +144,23 @@ class TestHomography:
         assert s.n_failed == 1
         # curve (0,0) (.5,.25) (1,.5) (3,.75) held to 5: .0625+.1875+1.25+1.5 = 3.0 -> /5
         assert s.auc_5_px == pytest.approx(0.6, abs=1e-15)
+
+
+def test_epipolar_distance_stats_match_opencv_epilines(two_view_points):
+    """The survey's measure against cv2.computeCorrespondEpilines (lines with a^2 + b^2 = 1)."""
+    x1, x2, F, _, _ = two_view_points(50, 2)
+    rng = np.random.default_rng(0)
+    y1, y2 = x1 + rng.normal(0, 1.5, x1.shape), x2 + rng.normal(0, 1.5, x2.shape)
+    l2 = cv2.computeCorrespondEpilines(y1.reshape(-1, 1, 2), 1, F).reshape(-1, 3)  # lines in image 2
+    l1 = cv2.computeCorrespondEpilines(y2.reshape(-1, 1, 2), 2, F).reshape(-1, 3)  # lines in image 1
+    ref1 = np.abs(np.sum(l1[:, :2] * y1, axis=1) + l1[:, 2])
+    ref2 = np.abs(np.sum(l2[:, :2] * y2, axis=1) + l2[:, 2])
+    d1, d2 = epipolar_line_distances_px(F, y1, y2)
+    np.testing.assert_allclose(d1, ref1, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(d2, ref2, rtol=1e-9, atol=1e-9)
+    r = epipolar_distance_stats(F, y1, y2)
+    ref = np.r_[ref1, ref2]
+    assert r.n_points == 50 and abs(r.mean_px - ref.mean()) <= 1e-9 and abs(r.std_px - ref.std()) <= 1e-9
+    assert epipolar_distance_stats(F, x1, x2).mean_px < 1e-9  # exact points lie on their lines
+    bad = epipolar_distance_stats(np.eye(3), y1, y2)
+    assert bad.failed and bad.failure_reason == "rank 3" and bad.mean_px == np.inf

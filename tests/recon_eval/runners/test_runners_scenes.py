@@ -42,7 +42,9 @@ def results(datasets, tmp_path_factory):
     plan = [("calib_checkerboard", "opencv-calib-checkerboard"), ("calib_checkerboard", "broken-calib-cx"),
             ("calib_checkerboard_noisy", "opencv-calib-checkerboard"), ("stereo_tabletop", "opencv-stereo-sgbm"),
             ("wide_baseline", "opencv-f-ransac"), ("wide_baseline", "opencv-f-8point"),
-            ("wide_baseline", "broken-f-transposed"), ("orbit_sfm", "pycolmap-incremental")]
+            ("wide_baseline", "broken-f-transposed"), ("orbit_sfm", "pycolmap-incremental"),
+            ("wide_baseline", "opencv-f-7point"), ("wide_baseline", "survey-f-seven-point"),
+            ("wide_baseline", "survey-f-cfns"), ("wide_baseline", "survey-f-mlesac")]
     out = {}
     for scene, m in plan:
         run_method(m, datasets[scene], root / scene / m)
@@ -92,6 +94,22 @@ def test_fundamental_ransac_recall_and_8point_sampson(results):
     assert r["synthetic.inlier_recall"] > 0.8  # issue 7, 30 % outliers, sigma 0.5 px
     e = _metrics(results, "wide_baseline", "opencv-f-8point")
     assert e["synthetic.sampson_rms_px"] <= 2 * 0.5  # within 2 x the noise sigma
+
+
+def test_survey_estimators_run_on_the_wide_baseline_scene(results):
+    """Issue 34: the survey's methods as runners. The 7-point method is fed the same seven labelled
+    inliers as OpenCV's and writes the same F; CFNS on the labelled inliers is within the noise;
+    MLESAC finds the inliers among 30 % outliers."""
+    import numpy as np
+
+    ours = results[("wide_baseline", "survey-f-seven-point")].parent / "pair_0000__pair_0001/synthetic_F.txt"
+    theirs = results[("wide_baseline", "opencv-f-7point")].parent / "pair_0000__pair_0001/synthetic_F.txt"
+    a, b = np.loadtxt(ours), np.loadtxt(theirs)
+    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    assert min(np.linalg.norm(a - b), np.linalg.norm(a + b)) <= 1e-6  # measured 2.9e-8 (OpenCV: unnormalised pixels)
+    assert _metrics(results, "wide_baseline", "survey-f-cfns")["synthetic.sampson_rms_px"] <= 2 * 0.5
+    m = _metrics(results, "wide_baseline", "survey-f-mlesac")
+    assert m["synthetic.inlier_recall"] > 0.8 and m["synthetic.sampson_rms_px"] <= 2 * 0.5
 
 
 def test_pycolmap_registers_every_image(results):

@@ -1,0 +1,38 @@
+"""A sweep's tables and figures (recon_eval.report.sweep_report) from a hand-made result."""
+from __future__ import annotations
+
+import math
+
+from recon_eval.report.sweep_report import breakdown_table, cells_table, figures, markdown
+from recon_eval.sweep.summary import breakdown_points
+
+
+def _results():
+    cells = []
+    for m, fam, errs in (("survey-f-fns", "iterative", {0.0: (0.1, 30.0), 1.0: (0.4, 50.0)}),
+                         ("survey-f-ransac", "robust", {0.0: (0.1, 0.2), 1.0: (0.3, 0.5)})):
+        for s, (e0, e1) in errs.items():
+            for f, e in ((0.0, e0), (0.4, e1)):
+                cells.append({"method": m, "family": fam, "sigma_px": s, "outlier_fraction": f, "epi_mean_px": e,
+                              "epi_std_px": e / 2, "median_trial_epi_px": e, "pose_err_deg": 10 * e})
+    cells[-1]["epi_mean_px"] = math.inf  # a failed cell reads "fail"
+    cfg = {"sigmas_px": [0.0, 1.0], "outlier_fractions": [0.0, 0.4], "breakdown_px": 1.0}
+    return {"config": cfg, "cells": cells, "breakdown": breakdown_points(cells, 1.0)}
+
+
+def test_tables_state_mean_std_and_breakdown():
+    r = _results()
+    t = cells_table(r, outlier_fraction=0.0)
+    assert "| `survey-f-fns` | iterative | 0.1 ± 0.05 | 0.4 ± 0.2 |" in t
+    assert "| `survey-f-ransac` | robust | 0.3 ± 0.15 | fail |" in cells_table(r, sigma_px=1.0)
+    b = breakdown_table(r)
+    assert "| `survey-f-fns` | iterative | 40% | 40% |" in b and "| `survey-f-ransac` | robust | > 40% | > 40% |" in b
+    assert "| `survey-f-fns` | iterative | 1 | 4 |" in cells_table(r, outlier_fraction=0.0, key="pose_err_deg")
+    assert markdown(r).count("|---|---|") == 5
+
+
+def test_figures_are_pngs_per_sigma():
+    figs = figures(_results())
+    assert [f.title for f in figs] == ["Error against noise", "Error against outliers, sigma 0 px",
+                                       "Error against outliers, sigma 1 px"]
+    assert all(f.png[:8] == b"\x89PNG\r\n\x1a\n" for f in figs)
