@@ -30,7 +30,7 @@ import trimesh
 
 from scenegen.assets.asset_refs import checked_ref, mtllib_names
 from scenegen.assets.shapes import uv_from_trimesh
-from scenegen.assets.textures import load_data_image, load_image
+from scenegen.assets.texture_files import load_data_image, load_image
 from scenegen.geometry.color import linear_from_srgb
 
 ALPHA_MODES = ("opaque", "mask", "blend")

@@ -9,7 +9,7 @@ import mitsuba as mi
 import numpy as np
 
 from scenegen.assets.meshes import texture_image
-from scenegen.assets.textures import load_data_image
+from scenegen.assets.texture_files import load_data_image
 from scenegen.spec import model as m
 
 #: Board pictures are black/white; printed paper is neither 0 nor 1 in reflectance.
