@@ -3,24 +3,17 @@ succeeds with the serial run's dataset, and the client removes the temporary fil
 left, so ``scenegen verify`` passes without a ``--resume``."""
 from __future__ import annotations
 
-import json
-import os
-import subprocess
 import sys
-import time
 from pathlib import Path
 
-import distributed
 import pytest
 
 from scenegen.cli import main
 from scenegen.dataset import verify
-from scenegen.dataset.files import TEMP_SUFFIX, sha256_file
+from scenegen.dataset.files import TEMP_SUFFIX
 
-ROOT = Path(__file__).resolve().parents[3]
-_CLI = Path(sys.executable).with_name("dask")  # `dask scheduler`, `dask worker`, as a user starts them
-DASK = (([str(_CLI), "scheduler"], [str(_CLI), "worker"]) if _CLI.is_file() else
-        ([sys.executable, "-m", "distributed.cli.dask_scheduler"], [sys.executable, "-m", "distributed.cli.dask_worker"]))
+sys.path.insert(0, str(Path(__file__).parent))
+from external_dask import external_cluster, file_hashes  # noqa: E402
 
 SPEC = """
 name: killed_worker
@@ -61,52 +54,25 @@ os.replace = _replace_then_die
 '''
 
 
-def _hashes(root: Path) -> dict:
-    return {p.relative_to(root).as_posix(): sha256_file(p) for p in sorted(root.rglob("*")) if p.is_file()}
-
-
-def _wait(cond, what: str, timeout_s: float = 60.0):
-    t0 = time.monotonic()
-    while not cond():
-        if time.monotonic() - t0 > timeout_s:
-            raise TimeoutError(what)
-        time.sleep(0.05)
-
-
 @pytest.mark.render
 def test_worker_killed_mid_write_leaves_no_temp_file(tmp_path):
     spec = tmp_path / "scene.yaml"
     spec.write_text(SPEC)
     (tmp_path / "die_mid_write.py").write_text(DIE_MID_WRITE)
     killed_at = tmp_path / "killed_at.txt"
-    sched_file = tmp_path / "scheduler.json"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=tmp_path)
-    procs = [subprocess.Popen([*DASK[0], "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                               "--scheduler-file", str(sched_file)], env=env, **quiet)]
-    try:
-        _wait(sched_file.is_file, "the scheduler did not start")
-        addr = json.loads(sched_file.read_text())["address"]
-        worker = [*DASK[1], addr, "--nthreads", "1", "--no-nanny", "--no-dashboard"]
-        procs.append(subprocess.Popen([*worker, "--name", "doomed", "--preload", str(tmp_path / "die_mid_write.py")],
-                                      env={**env, "SCENEGEN_TEST_KILLED_AT": str(killed_at)}, **quiet))
-        procs.append(subprocess.Popen([*worker, "--name", "survivor"], env=env, **quiet))
-        with distributed.Client(addr, timeout="30s") as c:
-            c.wait_for_workers(2, timeout=60)
+    workers = [(["--name", "doomed", "--preload", str(tmp_path / "die_mid_write.py")],
+                {"SCENEGEN_TEST_KILLED_AT": str(killed_at)}), (["--name", "survivor"], {})]
+    with external_cluster(tmp_path, workers) as (addr, procs):
         out = tmp_path / "dist"
         assert main(["render", str(spec), "-o", str(out), "-q", "--scheduler", addr]) == 0
         assert killed_at.is_file(), "the doomed worker never wrote (the test needs it killed mid-write)"
         left = Path(killed_at.read_text())
         assert left.parent.parent == out and left.name.endswith(TEMP_SUFFIX)
-        procs[1].wait(timeout=30)
-        assert procs[1].returncode == -9  # SIGKILL, with its temporary file complete on disk
+        procs[0].wait(timeout=30)
+        assert procs[0].returncode == -9  # SIGKILL, with its temporary file complete on disk
         assert not left.exists() and not list(out.rglob(f"*{TEMP_SUFFIX}"))
         assert verify(out).ok
         assert main(["verify", str(out)]) == 0
-    finally:
-        for p in procs[::-1]:
-            p.kill()
-            p.wait(timeout=30)
     serial = tmp_path / "serial"
     assert main(["render", str(spec), "-o", str(serial), "-q"]) == 0
-    assert _hashes(out) == _hashes(serial)
+    assert file_hashes(out) == file_hashes(serial)
