@@ -21,12 +21,13 @@ from scenegen.spec.parse.read import read_int
 from scenegen.spec.parse.render import parse_render
 from scenegen.spec.parse.rigs import parse_rig
 from scenegen.spec.parse.timeline import check_sequence, parse_sequence
+from scenegen.spec.parse.truth import parse_truth
 from scenegen.spec.parse.variation import parse_variation
 from scenegen.spec.parse.views import parse_view_set
 from scenegen.spec.views import resolve_views
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview", "variation", "sequence")
+                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth")
 #: Scene name of spec text that comes from no file.
 TEXT_SCENE_NAME = "scene"
 
@@ -65,11 +66,13 @@ def parse_document(doc: Document) -> SceneSpec:
     crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
+    truth = parse_truth(f.get("truth"), ctx) if "truth" in f else None
     spec = SceneSpec(
         name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
         rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
-        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence)
+        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
+        truth=truth)
     views = resolve_views(spec)  # degenerate placements are errors now, not at render time
     if sequence is not None:
         check_sequence(f, spec)

@@ -1,0 +1,18 @@
+"""Per-view truth written only when a spec asks for it (the optional ``truth:`` section): the
+diffuse albedo the renderer used and each image's calibrated lights (photometric stereo,
+docs/dataset_format.md "Albedo and light truth")."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from scenegen.errors import Where
+from scenegen.spec.model.meta import param, where_field
+
+
+@dataclass(frozen=True, kw_only=True)
+class TruthSpec:
+    albedo: bool = param(False, unit="flag")  # truth/<view>_albedo.exr: the diffuse reflectance
+    # of the surface each pixel centre's ray hits (linear RGB, per channel)
+    lights: bool = param(False, unit="flag")  # truth/<view>_lights.json: every light on in the
+    # view, stated in the camera frame (directions, irradiance, positions)
+    where: Where | None = where_field()

@@ -1,0 +1,18 @@
+"""``truth:``: the per-view truth written only on request (albedo, calibrated lights)."""
+from __future__ import annotations
+
+from scenegen.located_yaml import Node
+from scenegen.spec.model.meta import spec_fields
+from scenegen.spec.model.truth import TruthSpec
+from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.read import read_bool
+
+KEYS = tuple(fi.name for fi in spec_fields(TruthSpec))
+
+
+def parse_truth(node: Node, ctx: ParseContext) -> TruthSpec:
+    f = node.as_mapping(f"a truth section ({', '.join(KEYS)}: true or false)").check(optional=KEYS)
+    if ctx.sequence is not None and read_bool(f, TruthSpec, "albedo"):
+        raise f.get("albedo").error("albedo truth is for static scenes; this spec has a `sequence:`")
+    return TruthSpec(albedo=read_bool(f, TruthSpec, "albedo"), lights=read_bool(f, TruthSpec, "lights"),
+                     where=node.where)
