@@ -5,7 +5,8 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolmap incremental
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
-:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
+:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
@@ -54,7 +55,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
+         ("photometric", None): "photometric stereo", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
@@ -103,6 +104,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-lk-tracks", "flow", "lk", "cv2.goodFeaturesToTrack + calcOpticalFlowPyrLK (21 px, 3 levels) tracks"),
     _m("opencv-lk-tapvid", "tracking", "lk_tapvid",
        "chained cv2.calcOpticalFlowPyrLK (21 px, 3 levels, forward-backward check) from the truth query points"),
+    _m("woodham-ps", "photometric", "run",
+       "Woodham's least-squares photometric stereo (calibrated lights, shadows below 0.02 left out), "
+       "Frankot-Chellappa integration to depth (numpy)", shadow_threshold=0.02),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.
