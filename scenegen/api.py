@@ -93,11 +93,12 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
           cameras: Iterable[CameraSpec] | Mapping[str, CameraSpec] = (), rigs: Iterable[Rig] | Mapping = (),
           views: Iterable[ViewSet] = (), materials: Mapping = frozen_mapping(), render: RenderSettings | None = None,
           crossview: CrossviewSpec | None = None, variation=None, seed: int = 0, description: str = "",
-          base_dir=None) -> SceneSpec:
+          base_dir=None, truth=None) -> SceneSpec:
     """A validated :class:`SceneSpec` (what ``load_spec`` gives for the same YAML, warnings
     included). Object ids are the objects' positions (1-based); a material given by name is
     looked up in ``materials``; ``base_dir`` is where relative mesh and image paths resolve
-    (default: the current directory). SpecError naming the field on a bad value."""
+    (default: the current directory); ``truth``: a :class:`scenegen.spec.model.TruthSpec` (albedo and
+    light truth on request). SpecError naming the field on a bad value."""
     mats = _named(materials, "material")
     objs = []
     for i, o in enumerate(objects):
@@ -113,7 +114,7 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
                      cameras=frozen_mapping(_named(cameras, "camera")), rigs=frozen_mapping(_named(rigs, "rig")),
                      view_sets=tuple(views), file=PYTHON_FILE,
                      base_dir=Path(base_dir).resolve() if base_dir is not None else Path.cwd(),
-                     crossview=crossview, variation=variation)
+                     crossview=crossview, variation=variation, truth=truth)
     return check_spec(spec)
 
 
