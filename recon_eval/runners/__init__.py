@@ -6,7 +6,8 @@ findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolm
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
-(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.external`
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus),
+:mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
@@ -55,7 +56,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("photometric", None): "photometric stereo", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
+         ("photometric", None): "photometric stereo", ("focus", None): "depth from focus", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
@@ -107,6 +108,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("woodham-ps", "photometric", "run",
        "Woodham's least-squares photometric stereo (calibrated lights, shadows below 0.02 left out), "
        "Frankot-Chellappa integration to depth (numpy)", shadow_threshold=0.02),
+    _m("sml-dff", "focus", "sml",
+       "depth from focus: sum-modified-Laplacian (9 x 9 window), Gaussian peak interpolation in inverse depth",
+       window=4),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

@@ -31,8 +31,10 @@ from scenegen.dataset.layout import (
     MESHES_DIR,
     TARGETS_DIR,
     VIGNETTING_CHANNEL,
+    COC_CHANNEL,
     albedo_path,
     check_listed_names,
+    coc_path,
     check_rel_path,
     mesh_path,
     names_under,
@@ -241,6 +243,12 @@ class Dataset:
         rel = albedo_path(self.check_view(view))
         return self.read(rel, lambda p: decode_albedo(read_exr(p)), f"albedo of view {view!r}") \
             if self.has(rel) else None
+
+    def coc_radius_px(self, view: str) -> np.ndarray | None:
+        """(H, W) float32 thin-lens circle-of-confusion radius (px) of each pixel's truth point
+        (NaN on misses), or None when the spec did not ask for it (``truth: {defocus: true}``)."""
+        rel = coc_path(self.check_view(view))
+        return self.read(rel, read_exr, f"circle of confusion of view {view!r}")[COC_CHANNEL] if self.has(rel) else None
 
     def lights(self, view: str) -> tuple[ViewLight, ...] | None:
         """The lights on in a view, in its camera frame (:class:`scenegen.dataset.photometric.ViewLight`),

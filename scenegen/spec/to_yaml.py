@@ -324,7 +324,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     if spec.variation is not None:
         d["variation"] = _variation(spec.variation)
     if spec.truth is not None:
-        d["truth"] = {"albedo": spec.truth.albedo, "lights": spec.truth.lights}
+        d["truth"] = {"albedo": spec.truth.albedo, "lights": spec.truth.lights, "defocus": spec.truth.defocus}
     return d
 
 

@@ -41,3 +41,9 @@ def test_bad_values_name_their_field(text, fragment):
     with pytest.raises(SpecError) as e:
         parse_spec(text)
     assert fragment in str(e.value)
+
+
+def test_defocus_truth_without_a_lens_is_a_warning():
+    spec = parse_spec(CAM + "truth: {defocus: true}\n")
+    assert spec.truth.defocus and any("thin lens" in w for w in spec.warnings)
+    assert spec_to_dict(parse_spec(CAM + "truth: {lights: true}\n"))["truth"] == {"albedo": False, "lights": True}
