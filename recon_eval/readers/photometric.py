@@ -39,10 +39,11 @@ def _read(fn, *args):
         raise InputError(str(exc)) from None
 
 
-def photometric_sets(root) -> list[PhotometricSet]:
+def photometric_sets(root, min_views: int = 3) -> list[PhotometricSet]:
     """Every photometric stereo set of the dataset at ``root`` (views grouped by camera and
-    pose, in order; a group needs >= 3 views with one directional light each). NotApplicable
-    when the dataset has none (no ``truth: {lights: true}``, or no such views)."""
+    pose, in order; a group needs ``min_views`` views with one directional light each; 1 for
+    shape from shading). NotApplicable when the dataset has none (no ``truth: {lights: true}``,
+    or no such views)."""
     try:
         ds = Dataset(root)
     except DatasetError as exc:
@@ -55,9 +56,9 @@ def photometric_sets(root) -> list[PhotometricSet]:
         cam, pose = _read(ds.camera, v)
         key = (ds.view_info(v).get("camera_name"), tuple(np.round(pose.matrix.ravel(), 12)))
         groups.setdefault(key, []).append((v, lights[0]))
-    sets = [_stack(ds, members) for members in groups.values() if len(members) >= 3]
+    sets = [_stack(ds, members) for members in groups.values() if len(members) >= min_views]
     if not sets:
-        raise NotApplicable(f"{Path(root)}: no photometric stereo set (>= 3 views of one camera and pose, each "
+        raise NotApplicable(f"{Path(root)}: no photometric set (>= {min_views} views of one camera and pose, each "
                             "lit by one directional light, with truth/<view>_lights.json: spec truth.lights)")
     return sets
 

@@ -6,7 +6,7 @@ findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolm
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
-(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus),
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading),
 :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
@@ -56,7 +56,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("photometric", None): "photometric stereo", ("focus", None): "depth from focus", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
+         ("photometric", None): "photometric stereo", ("focus", None): "depth from focus",
+         ("shading", None): "shape from shading", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
@@ -111,6 +112,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("sml-dff", "focus", "sml",
        "depth from focus: sum-modified-Laplacian (9 x 9 window), Gaussian peak interpolation in inverse depth",
        window=4),
+    _m("ikeuchi-horn-sfs", "shading", "run",
+       "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
+       "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.
