@@ -165,3 +165,41 @@ def depth_up_to_offset(depth_gt, depth_est, mask) -> DepthFromNormalsResult:
     rmse = float(np.sqrt(np.mean(r * r)))
     return DepthFromNormalsResult(offset_m=off, rmse_m=rmse, mean_abs_m=float(np.abs(r).mean()),
                                   rel_rmse=rmse / relief if relief > 0 else float("nan"), n_pixels=int(m.sum()))
+
+
+@dataclass(frozen=True)
+class PlaneOrientationResult:
+    """A plane's estimated orientation against the truth (shape from texture): slant = angle
+    between the plane's normal and the optical axis, tilt = image direction (degrees from +u toward
+    +v) in which depth increases fastest."""
+
+    angle_err_deg: float  # between the estimated and true normals (both toward the camera)
+    angle_err_folded_deg: float  # the smaller error of the estimate and its mirror (-n_x, -n_y, n_z):
+    # orthographic foreshortening alone cannot tell tilt t from t + 180 deg
+    slant_err_deg: float  # |slant_est - slant_gt|
+    tilt_err_deg: float  # |tilt_est - tilt_gt| folded to [0, 180]; NaN when the truth's slant < 5 deg
+    slant_gt_deg: float
+    tilt_gt_deg: float
+
+
+def slant_tilt_deg(normal_cam) -> tuple[float, float]:
+    """(slant, tilt) in degrees of a plane normal in the OpenCV camera frame, turned toward the camera."""
+    n = np.asarray(normal_cam, np.float64) / np.linalg.norm(normal_cam)
+    n = -n if n[2] > 0 else n
+    return float(np.degrees(np.arccos(np.clip(-n[2], -1.0, 1.0)))), float(np.degrees(np.arctan2(n[1], n[0])))
+
+
+def plane_orientation_metrics(normal_gt_cam, normal_est_cam) -> PlaneOrientationResult:
+    """Orientation errors of a plane's normal (3,), OpenCV camera frame, either sign."""
+    g = as_float_array(normal_gt_cam, "plane normal (truth)", (3,))
+    e = as_float_array(normal_est_cam, "plane normal (estimate)", (3,))
+    if not (np.isfinite(e).all() and np.linalg.norm(e) > 0):
+        raise InputError("plane normal (estimate): expected a finite non-zero vector")
+    (sg, tg), (se, te) = slant_tilt_deg(g), slant_tilt_deg(e)
+    g, e = g / np.linalg.norm(g), e / np.linalg.norm(e)
+    g, e = (g if g[2] < 0 else -g), (e if e[2] < 0 else -e)
+    angle, mirrored = angular_errors_deg(np.stack([g, g]), np.stack([e, e * [-1.0, -1.0, 1.0]]))
+    dt = abs((te - tg + 180.0) % 360.0 - 180.0)
+    return PlaneOrientationResult(angle_err_deg=float(angle), angle_err_folded_deg=float(min(angle, mirrored)),
+                                  slant_err_deg=abs(se - sg),
+                                  tilt_err_deg=dt if sg >= 5.0 else float("nan"), slant_gt_deg=sg, tilt_gt_deg=tg)
