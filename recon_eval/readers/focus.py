@@ -21,6 +21,7 @@ class FocusStack:
     views: tuple[str, ...]
     focus_distance_m: np.ndarray  # (K,) the lens's in-focus depth of each view
     f_number: np.ndarray  # (K,)
+    blur_px_per_dioptre: np.ndarray  # (K,) fx A: blur-circle radius (px) per 1/m of defocus
     images_linear: np.ndarray  # (K, H, W) float64: the stored images, sRGB decoded, channel mean
     depth_z: np.ndarray  # (H, W) float64 metres, NaN on misses
     object_id: np.ndarray  # (H, W) uint32
@@ -42,9 +43,9 @@ def _lens(ds: Dataset, view: str) -> dict | None:
     return out
 
 
-def focus_stacks(root) -> list[FocusStack]:
-    """Every focus stack (>= 3 views of one pose with distinct focus distances) of the dataset at
-    ``root``, in order; NotApplicable when there is none."""
+def focus_stacks(root, min_views: int = 3) -> list[FocusStack]:
+    """Every focus stack (>= ``min_views`` views of one pose with distinct focus distances; 2 for a
+    defocus pair) of the dataset at ``root``, in order; NotApplicable when there is none."""
     try:
         ds = Dataset(root)
         groups: dict = {}
@@ -54,11 +55,11 @@ def focus_stacks(root) -> list[FocusStack]:
                 continue
             _, pose = ds.camera(v)
             groups.setdefault(tuple(np.round(pose.matrix.ravel(), 12)), []).append((lens["focus_distance_m"], v, lens))
-        stacks = [_stack(ds, sorted(g)) for g in groups.values() if len({z for z, _, _ in g}) >= 3]
+        stacks = [_stack(ds, sorted(g)) for g in groups.values() if len({z for z, _, _ in g}) >= min_views]
     except DatasetError as exc:
         raise InputError(str(exc)) from None
     if not stacks:
-        raise NotApplicable(f"{Path(root)}: no focus stack (>= 3 views of one pose through lenses focused at "
+        raise NotApplicable(f"{Path(root)}: no focus stack (>= {min_views} views of one pose through lenses focused at "
                             "different distances: cameras.<name>.lens)")
     return stacks
 
@@ -75,9 +76,12 @@ def _stack(ds: Dataset, members) -> FocusStack:
     depth = truth["depth_z"].astype(np.float64)
     depth[~np.isfinite(depth)] = np.nan
     cocs = [ds.coc_radius_px(v) for v in views]
+    fx = float(ds.camera(views[0])[0].fx)
     return FocusStack(
         views=views, focus_distance_m=np.array([z for z, _, _ in members]),
         f_number=np.array([lens["f_number"] for _, _, lens in members]),
+        blur_px_per_dioptre=np.array([fx * fx * lens["pixel_pitch_um"] * 1e-6 / (2 * lens["f_number"])
+                                      for _, _, lens in members]),
         images_linear=np.stack([_grey(ds.image(v)) for v in views]), depth_z=depth, object_id=truth["object_id"],
         coc_radius_px=None if any(c is None for c in cocs) else np.stack(cocs),
         objects={o["name"]: int(o["object_id"]) for o in ds.objects})

@@ -56,7 +56,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("photometric", None): "photometric stereo", ("focus", None): "depth from focus",
+         ("photometric", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
          ("shading", None): "shape from shading", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
@@ -112,6 +112,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("sml-dff", "focus", "sml",
        "depth from focus: sum-modified-Laplacian (9 x 9 window), Gaussian peak interpolation in inverse depth",
        window=4),
+    _m("stm-dfd", "focus", "stm",
+       "depth from defocus, two images: Subbarao and Surya's spatial-domain transform (Gaussian window 4 px), "
+       "thin-lens blur to depth in closed form", window_px=4.0),
     _m("ikeuchi-horn-sfs", "shading", "run",
        "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
        "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),
