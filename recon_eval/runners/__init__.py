@@ -6,7 +6,7 @@ findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolm
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
-(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture),
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming),
 :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
@@ -57,7 +57,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
          ("photometric", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
-         ("shading", None): "shape from shading", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
+         ("shading", None): "shape from shading", ("zoom", None): "depth from zooming", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
@@ -118,6 +118,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("ikeuchi-horn-sfs", "shading", "run",
        "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
        "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),
+    _m("sift-zoom-depth", "zoom", "radial",
+       "depth from zooming: SIFT matches from the widest view, depth from the radial magnification with the "
+       "calibrated focal lengths and pupil travel", min_radius_px=15.0),
     _m("texture-structure-tensor", "texture", "structure_tensor",
        "shape from texture: slant and tilt of a textured plane from its mean normalised structure tensor "
        "(isotropic texture, orthographic foreshortening), tilt sign from the texture's density gradient",
