@@ -95,7 +95,8 @@ def test_summary_of_a_run_lists_failed_invocations():
     ("n_points3d", True), ("cloud_precision_at_1cm", True), ("fx_rel_err", False), ("synthetic.floor.mace_px", False),
     ("views_used_ratio", True), ("abs_median_signed_err_px", False), ("sigma1.median_rel_err", False),
     ("localisation_err_px", False), ("calib_rms_px", False), ("median_signed_err_px", None),
-    ("description", None),
+    ("description", None), ("lambertian.within_10deg", True), ("all.albedo_rel_mae", False), ("coverage", True),
+    ("lambertian.mean_ae_deg", False),
 ])
 def test_direction_of_the_leaderboard_metrics(metric, higher):
     assert higher_is_better(metric) is higher
