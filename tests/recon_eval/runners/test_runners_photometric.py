@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
+from recon_eval.cli import main as cli_main
 from recon_eval.readers.photometric import photometric_sets
 from recon_eval.runners import run_method
 from recon_eval.runners.photometric import frankot_chellappa, woodham
@@ -111,3 +112,5 @@ def test_runner_error_grows_with_specular_and_shadowed_cases(ps_dataset, tmp_pat
     assert m["lambertian.mean_ae_deg"] < m["shadowed.mean_ae_deg"] < m["specular.mean_ae_deg"]
     assert m["lambertian.albedo_rel_mae"] < 0.05
     assert (tmp_path / "run" / "ps" / "normals.npy").is_file() and (tmp_path / "run" / "result.json").is_file()
+    gates = Path(__file__).parents[3] / "gates" / "photometric_stereo.yaml"
+    assert cli_main(["gate", str(gates), str(tmp_path / "run" / "result.json"), "-q"]) == 0  # the project's gates hold
