@@ -45,11 +45,16 @@ def woodham(images: np.ndarray, directions: np.ndarray, intensities: np.ndarray,
     todo = mask.reshape(-1) & (lit.sum(axis=1) >= MIN_LIGHTS)
     normals = np.zeros((H * W, 3))
     albedo = np.full((H * W, 3), np.nan)
-    codes = lit.astype(np.int64) @ (1 << np.arange(K, dtype=np.int64))  # one system per subset of lights
     obs_c = obs.reshape(K, -1, 3).transpose(1, 0, 2)  # (P, K, 3)
-    for code in np.unique(codes[todo]):
-        px = np.flatnonzero(todo & (codes == code))
-        use = ((code >> np.arange(K)) & 1).astype(bool)
+    idx = np.flatnonzero(todo)
+    if len(idx) == 0:
+        return normals.reshape(H, W, 3), albedo.reshape(H, W, 3)
+    subsets, which = np.unique(lit[idx], axis=0, return_inverse=True)  # one system per subset of lights
+    which = which.reshape(-1)
+    order = np.argsort(which, kind="stable")
+    bounds = np.searchsorted(which[order], np.arange(len(subsets) + 1))
+    for j, use in enumerate(subsets):
+        px = idx[order[bounds[j]:bounds[j + 1]]]
         L = directions[use]  # (k, 3)
         b = np.linalg.lstsq(L, grey[px][:, use].T, rcond=None)[0].T  # (n, 3)
         norm = np.linalg.norm(b, axis=1)

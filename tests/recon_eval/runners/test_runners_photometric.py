@@ -57,6 +57,21 @@ def test_woodham_is_exact_on_exact_lambertian_data():
     np.testing.assert_allclose(a_est, rho, atol=1e-12)
 
 
+def test_woodham_with_more_lights_than_bits_in_an_integer():
+    # DiLiGenT has 96 lights: the shadow subsets must not be packed into a 64-bit code
+    rng = np.random.default_rng(5)
+    K = 96
+    L = np.c_[rng.uniform(-0.5, 0.5, (K, 2)), -np.ones(K)]
+    L /= np.linalg.norm(L, axis=1, keepdims=True)
+    n = np.c_[rng.uniform(-0.7, 0.7, (30, 2)), -np.ones(30)]
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    n = n.reshape(5, 6, 3)
+    imgs = 0.6 * np.clip(np.einsum("hwc,kc->khw", n, L), 0, None)[..., None] * np.ones(3)
+    n_est, a_est = woodham(imgs, L, np.ones((K, 3)), np.ones((5, 6), bool), 0.01)
+    np.testing.assert_allclose(n_est, n, atol=1e-12)
+    np.testing.assert_allclose(a_est, 0.6, atol=1e-12)
+
+
 @pytest.fixture(scope="module")
 def ps_dataset(tmp_path_factory):
     out = tmp_path_factory.mktemp("ps") / "ps"
