@@ -23,12 +23,16 @@ class PhotometricSet:
     views: tuple[str, ...]  # K views, dataset order
     images_linear: np.ndarray  # (K, H, W, 3) float64: the stored images, sRGB decoded
     directions_cam: np.ndarray  # (K, 3) unit directions toward each image's light, OpenCV camera frame
-    intensities: np.ndarray  # (K, 3) radiance of a white Lambertian surface facing the light, per channel
+    # (a point light: from the camera toward it)
+    intensities: np.ndarray  # (K, 3) radiance of a white Lambertian surface facing the light, per
+    # channel (a point light: at 1 m from it, intensity_w_sr / pi)
+    positions_cam: np.ndarray  # (K, 3) point lights' positions (metres, camera frame); NaN rows: directional
     normals_cam: np.ndarray  # (H, W, 3) float64 truth normals, OpenCV camera frame (NaN on misses)
     albedo: np.ndarray | None  # (H, W, 3) float64 truth albedo, or None when not written
     depth_z: np.ndarray  # (H, W) float64 metres, NaN on misses
     object_id: np.ndarray  # (H, W) uint32, 0 = nothing
     fx_px: float  # focal length of the camera (pixels), for integrating normals
+    camera: object  # scenegen.geometry.camera.Camera of the views
     objects: dict  # object name -> object id
 
 
@@ -51,7 +55,7 @@ def photometric_sets(root, min_views: int = 3) -> list[PhotometricSet]:
     groups: dict = {}
     for v in ds.views:
         lights = _read(ds.lights, v)
-        if not lights or len(lights) != 1 or lights[0].type != "directional":
+        if not lights or len(lights) != 1 or lights[0].type not in ("directional", "point"):
             continue
         cam, pose = _read(ds.camera, v)
         key = (ds.view_info(v).get("camera_name"), tuple(np.round(pose.matrix.ravel(), 12)))
@@ -77,10 +81,14 @@ def _stack(ds: Dataset, members) -> PhotometricSet:
     depth = truth["depth_z"].astype(np.float64)
     depth[~np.isfinite(depth)] = np.nan
     cam, _ = _read(ds.camera, first)
+    lights = [li for _, li in members]
+    pos = np.array([li.position_cam if li.type == "point" else (np.nan,) * 3 for li in lights], np.float64)
+    dirs = np.array([li.direction_to_light_cam if li.type == "directional" else p / np.linalg.norm(p)
+                     for li, p in zip(lights, pos)], np.float64)
+    inten = np.array([li.intensity if li.type == "directional" else np.array(li.intensity_w_sr) / np.pi
+                      for li in lights], np.float64)
     return PhotometricSet(
-        views=views, images_linear=np.stack(images),
-        directions_cam=np.array([li.direction_to_light_cam for _, li in members], np.float64),
-        intensities=np.array([li.intensity for _, li in members], np.float64),
+        views=views, images_linear=np.stack(images), directions_cam=dirs, intensities=inten, positions_cam=pos,
         normals_cam=truth["normals_cam"].astype(np.float64), albedo=None if albedo is None else albedo.astype(np.float64),
-        depth_z=depth, object_id=truth["object_id"], fx_px=float(cam.fx),
+        depth_z=depth, object_id=truth["object_id"], fx_px=float(cam.fx), camera=cam,
         objects={o["name"]: int(o["object_id"]) for o in ds.objects})

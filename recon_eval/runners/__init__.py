@@ -6,7 +6,7 @@ findHomography), :mod:`.pnp` (solvePnP / solvePnPRansac), :mod:`.colmap` (pycolm
 SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
-(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming),
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.near_light` (under point lights), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming),
 :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
@@ -56,7 +56,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("photometric", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
+         ("photometric", None): "photometric stereo", ("near_light", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
          ("shading", None): "shape from shading", ("zoom", None): "depth from zooming", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("external", "disparity"): "stereo disparity",
@@ -109,6 +109,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("woodham-ps", "photometric", "run",
        "Woodham's least-squares photometric stereo (calibrated lights, shadows below 0.02 left out), "
        "Frankot-Chellappa integration to depth (numpy)", shadow_threshold=0.02),
+    _m("woodham-near-ps", "near_light", "woodham_near",
+       "near-light photometric stereo: Woodham per pixel with the point lights' own directions and 1/r^2, "
+       "alternated with Frankot-Chellappa depth (4 rounds)", shadow_threshold=0.02, iterations=4),
     _m("sml-dff", "focus", "sml",
        "depth from focus: sum-modified-Laplacian (9 x 9 window), Gaussian peak interpolation in inverse depth",
        window=4),

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from recon_eval.errors import NotApplicable
 from recon_eval.metrics.normals import albedo_metrics, depth_up_to_offset, normal_metrics
 from recon_eval.readers.photometric import PhotometricSet, photometric_sets
 from recon_eval.runners.common import RunOutput, out_path
@@ -95,7 +96,9 @@ def depth_from_normals(normals_diligent: np.ndarray, mask: np.ndarray, metres_pe
     return np.where(mask, depth_ref_m - h, np.nan)
 
 
-def _score(s: PhotometricSet, normals_cv: np.ndarray, albedo: np.ndarray, depth: np.ndarray) -> tuple[dict, dict]:
+def score_set(s: PhotometricSet, normals_cv: np.ndarray, albedo: np.ndarray, depth: np.ndarray) -> tuple[dict, dict]:
+    """(results, headline metrics) of a set's normals (camera frame), albedo and depth, over all
+    objects and per object: DiLiGenT's normal metrics, albedo up to scale, depth up to offset."""
     results, metrics = {}, {}
     groups = {"all": s.object_id > 0, **{name: s.object_id == oid for name, oid in s.objects.items()}}
     for name, m in groups.items():
@@ -118,7 +121,9 @@ def _score(s: PhotometricSet, normals_cv: np.ndarray, albedo: np.ndarray, depth:
 def run(ds, out_dir, options) -> RunOutput:
     threshold = float(options.get("shadow_threshold", 0.02))
     results, metrics, raw = {}, {}, []
-    sets = photometric_sets(ds.root)
+    sets = [s for s in photometric_sets(ds.root) if np.isnan(s.positions_cam).all()]
+    if not sets:
+        raise NotApplicable(f"{ds.root}: no photometric stereo set under distant (directional) lights")
     for k, s in enumerate(sets):
         mask = s.object_id > 0
         n_cv, albedo = woodham(s.images_linear, s.directions_cam, s.intensities, mask, threshold)
@@ -132,7 +137,7 @@ def run(ds, out_dir, options) -> RunOutput:
             atomic_write_bytes(out_path(out_dir, f"{prefix}/{name}"), encode_npy(arr))
             raw.append(f"{prefix}/{name}")
         back = {name: np.load(out_path(out_dir, f"{prefix}/{name}")).astype(np.float64) for name in files}
-        r, mt = _score(s, back["normals.npy"] @ DILIGENT_FROM_OPENCV_CAM.T, back["albedo.npy"], back["depth.npy"])
+        r, mt = score_set(s, back["normals.npy"] @ DILIGENT_FROM_OPENCV_CAM.T, back["albedo.npy"], back["depth.npy"])
         results.update({f"{prefix}.{key}" if len(sets) > 1 else key: v for key, v in r.items()})
         metrics.update({f"{prefix}.{key}" if len(sets) > 1 else key: v for key, v in mt.items()})
     notes = {"sets": [list(s.views) for s in sets], "shadow_threshold": threshold,

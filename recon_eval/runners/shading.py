@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import distance_transform_edt, uniform_filter
 
+from recon_eval.errors import NotApplicable
 from recon_eval.metrics.normals import depth_up_to_offset, normal_metrics
 from recon_eval.readers.photometric import photometric_sets
 from recon_eval.runners.common import RunOutput, out_path
@@ -70,7 +71,9 @@ def ikeuchi_horn(E: np.ndarray, albedo: float, light_diligent: np.ndarray, mask:
 def run(ds, out_dir, options) -> RunOutput:
     iterations = int(options.get("iterations", 200))
     step = float(options.get("step", 8.0))
-    sets = photometric_sets(ds.root, min_views=1)
+    sets = [s for s in photometric_sets(ds.root, min_views=1) if np.isnan(s.positions_cam).all()]
+    if not sets:
+        raise NotApplicable(f"{ds.root}: no image lit by one directional light")
     s = sets[0]
     if s.albedo is None:
         raise ValueError(f"{ds.root}: shape from shading needs the albedo truth (spec truth.albedo)")

@@ -37,12 +37,19 @@ def ps(tmp_path_factory):
 
 
 def _model_ratio(d: Dataset, view: str, object_id: int, direction=None) -> tuple[np.ndarray, np.ndarray]:
-    """(|render - model| / tolerance, kept mask) of one view (module docstring)."""
+    """(|render - model| / tolerance, kept mask) of one view (module docstring); a point light's
+    direction and irradiance are the truth point's own: l = (s - X) / r, intensity / (pi r^2)."""
     t, albedo, (light,) = d.truth(view), d.albedo(view), d.lights(view)
     img = d.linear_image(view).astype(np.float64)
-    l_cam = np.array(light.direction_to_light_cam if direction is None else direction)
-    ndl = t["normals_cam"].astype(np.float64) @ l_cam
-    pred = albedo * np.clip(ndl, 0, None)[..., None] * np.array(light.intensity)
+    if light.type == "point":
+        V = np.array(light.position_cam) - t["points_cam"].astype(np.float64)
+        r = np.linalg.norm(V, axis=-1)
+        ndl = np.sum(t["normals_cam"].astype(np.float64) * V, axis=-1) / r
+        pred = albedo * np.clip(ndl, 0, None)[..., None] * (np.array(light.intensity_w_sr) / np.pi) / (r * r)[..., None]
+    else:
+        l_cam = np.array(light.direction_to_light_cam if direction is None else direction)
+        ndl = t["normals_cam"].astype(np.float64) @ l_cam
+        pred = albedo * np.clip(ndl, 0, None)[..., None] * np.array(light.intensity)
     on = t["object_id"] == object_id
     inner = ndimage.binary_erosion(on, np.ones((3, 3)), border_value=0)
     lit = ndimage.minimum_filter(np.where(on, ndl, -1.0), 3) > 0.05
@@ -70,6 +77,19 @@ def test_lambertian_render_equals_albedo_times_cosine_times_intensity(ps):
         assert ratio[keep].max() < 1.0, view
         kept += int(keep.sum())
     assert kept > 10_000
+
+
+def test_point_lights_too(tmp_path):
+    out = tmp_path / "near"
+    render_spec(SCENE.parent / "photometric_stereo_near.yaml", out, spp=SPP, progress=False, show_warnings=False)
+    d = Dataset(out)
+    oid = _object_id(d, "lambertian")
+    for view in d.views[::3]:
+        (light,) = d.lights(view)
+        assert light.type == "point" and light.position_cam is not None
+        ratio, keep = _model_ratio(d, view, oid)
+        assert keep.sum() > 0.5 * (d.truth(view)["object_id"] == oid).sum()
+        assert ratio[keep].max() < 1.0, view
 
 
 def test_the_comparison_sees_a_light_two_degrees_off(ps):
