@@ -59,7 +59,7 @@ def score(a):
         truth = ds.truth(ds.check_view(view))
         albedo_gt = ds.albedo(view) if a.albedo else None
     except (DatasetError, KeyError) as exc:
-        raise InputError(str(exc.args[0] if isinstance(exc, KeyError) else exc)) from None
+        raise InputError(f"{a.gt}: {exc.args[0]}" if isinstance(exc, KeyError) else str(exc)) from None
     est = read_normal_map(a.est)
     gt_n = truth["normals_cam"].astype(np.float64)
     if est.shape != gt_n.shape:

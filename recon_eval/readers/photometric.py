@@ -63,7 +63,7 @@ def photometric_sets(root, min_views: int = 3) -> list[PhotometricSet]:
     sets = [_stack(ds, members) for members in groups.values() if len(members) >= min_views]
     if not sets:
         raise NotApplicable(f"{Path(root)}: no photometric set (>= {min_views} views of one camera and pose, each "
-                            "lit by one directional light, with truth/<view>_lights.json: spec truth.lights)")
+                            "lit by one directional or point light, with truth/<view>_lights.json: spec truth.lights)")
     return sets
 
 
