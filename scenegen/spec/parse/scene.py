@@ -73,6 +73,12 @@ def parse_document(doc: Document) -> SceneSpec:
         rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
         warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
         truth=truth)
+    if truth is not None and truth.albedo:
+        moving = [o.name for o in objects if o.motion is not None and not o.motion.is_static] + \
+                 [vs.prefix for vs in view_sets if vs.motion is not None and not vs.motion.is_static]
+        if moving:
+            raise f.get("truth").as_mapping().get("albedo").error(
+                f"albedo truth is for a still camera over a static scene; {moving[0]!r} moves (`motion:`)")
     views = resolve_views(spec)  # degenerate placements are errors now, not at render time
     if sequence is not None:
         check_sequence(f, spec)

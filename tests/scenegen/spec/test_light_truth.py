@@ -47,3 +47,11 @@ def test_defocus_truth_without_a_lens_is_a_warning():
     spec = parse_spec(CAM + "truth: {defocus: true}\n")
     assert spec.truth.defocus and any("thin lens" in w for w in spec.warnings)
     assert spec_to_dict(parse_spec(CAM + "truth: {lights: true}\n"))["truth"] == {"albedo": False, "lights": True}
+
+
+def test_albedo_truth_refuses_motion_at_its_field():
+    text = (CAM + "objects:\n  - {name: b, shape: sphere, motion: {linear_velocity_mps: [1, 0, 0]}}\n"
+            "truth: {albedo: true}\n")
+    with pytest.raises(SpecError) as e:
+        parse_spec(text)
+    assert "albedo" in str(e.value) and "'b' moves" in str(e.value)
