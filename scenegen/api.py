@@ -252,12 +252,13 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
           cameras: Iterable[CameraSpec] | Mapping[str, CameraSpec] = (), rigs: Iterable[Rig] | Mapping = (),
           views: Iterable[ViewSet] = (), materials: Mapping = frozen_mapping(), render: RenderSettings | None = None,
           crossview: CrossviewSpec | None = None, variation=None, seed: int = 0, description: str = "",
-          base_dir=None, sequence: SequenceSpec | None = None) -> SceneSpec:
+          base_dir=None, sequence: SequenceSpec | None = None, truth=None) -> SceneSpec:
     """A validated :class:`SceneSpec` (what ``load_spec`` gives for the same YAML, warnings
     included). Object ids are the objects' positions (1-based); a material given by name is
     looked up in ``materials``; ``base_dir`` is where relative mesh and image paths resolve
     (default: the current directory); ``sequence`` (:func:`sequence`) makes it a sequence: an
-    animated object's pose at frame 0 and a trajectory placement's times come from it.
+    animated object's pose at frame 0 and a trajectory placement's times come from it;
+    ``truth``: a :class:`scenegen.spec.model.TruthSpec` (albedo and light truth on request).
     SpecError naming the field on a bad value."""
     objects = _checked(objects, "objects", (SceneObject,))  # the arguments' types first: errors name them
     lights = _checked(lights, "lights", get_args(Light))
@@ -291,7 +292,8 @@ def Scene(name: str = "scene", *, objects: Iterable[SceneObject] = (), lights: I
                          li, name=default_light_name(i)), base, f"lights[{i}]") for i, li in enumerate(lights)),
                      cameras=frozen_mapping(_named(cameras, "camera")), rigs=frozen_mapping(_named(rigs, "rig")),
                      view_sets=_views_on_clock(views, sequence), file=PYTHON_FILE, base_dir=base,
-                     crossview=crossview, variation=variation, sequence=sequence)
+                     crossview=crossview, variation=variation, sequence=sequence,
+                     truth=truth)
     return check_spec(spec)
 
 

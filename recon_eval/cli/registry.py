@@ -37,6 +37,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("depth", "depth maps: Eigen abs_rel, sq_rel, rmse, rmse_log, a1..a3", "maps"),
     Command("flow", "optical flow: EPE all/noc/occ, KITTI Fl bg/fg/all, Sintel s0-10/s10-40/s40+", "flow"),
     Command("tracks", "point tracks over a sequence: TAP-Vid AJ, < delta_avg, OA against the truth tracks", "tracks"),
+    Command("normals", "normal maps (photometric stereo): DiLiGenT mean/median angular error, < 10/20/30 deg; "
+                       "albedo up to scale; light directions", "photometric"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
     Command("sweep", "F estimators over noise and outliers on exact truth: mean/std epipolar distance, breakdown",
             "sweep", description="Sweep F estimators over Gaussian noise and outlier fractions drawn from DATASET's "

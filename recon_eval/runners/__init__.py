@@ -6,7 +6,9 @@ findHomography), :mod:`.fsurvey` (the nineteen F estimators of Armangue and Salv
 :mod:`recon_eval.estimators.fundamental`), :mod:`.pnp` (solvePnP / solvePnPRansac),
 :mod:`.colmap` (pycolmap incremental SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
-:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.external`
+:mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.near_light` (under point lights), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming),
+:mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
 :mod:`.common` (the run record), :mod:`.detect` (marker-board detection). :data:`METHODS` lists
@@ -56,7 +58,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
-         ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
+         ("photometric", None): "photometric stereo", ("near_light", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
+         ("shading", None): "shape from shading", ("zoom", None): "depth from zooming", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix",
          ("external", "disparity"): "stereo disparity",
@@ -108,6 +111,28 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-lk-tracks", "flow", "lk", "cv2.goodFeaturesToTrack + calcOpticalFlowPyrLK (21 px, 3 levels) tracks"),
     _m("opencv-lk-tapvid", "tracking", "lk_tapvid",
        "chained cv2.calcOpticalFlowPyrLK (21 px, 3 levels, forward-backward check) from the truth query points"),
+    _m("woodham-ps", "photometric", "run",
+       "Woodham's least-squares photometric stereo (calibrated lights, shadows below 0.02 left out), "
+       "Frankot-Chellappa integration to depth (numpy)", shadow_threshold=0.02),
+    _m("woodham-near-ps", "near_light", "woodham_near",
+       "near-light photometric stereo: Woodham per pixel with the point lights' own directions and 1/r^2, "
+       "alternated with Frankot-Chellappa depth (4 rounds)", shadow_threshold=0.02, iterations=4),
+    _m("sml-dff", "focus", "sml",
+       "depth from focus: sum-modified-Laplacian (9 x 9 window), Gaussian peak interpolation in inverse depth",
+       window=4),
+    _m("stm-dfd", "focus", "stm",
+       "depth from defocus, two images: Subbarao and Surya's spatial-domain transform (Gaussian window 4 px), "
+       "thin-lens blur to depth in closed form", window_px=4.0),
+    _m("ikeuchi-horn-sfs", "shading", "run",
+       "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
+       "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),
+    _m("sift-zoom-depth", "zoom", "radial",
+       "depth from zooming: SIFT matches from the widest view, depth from the radial magnification with the "
+       "calibrated focal lengths and pupil travel", min_radius_px=15.0),
+    _m("texture-structure-tensor", "texture", "structure_tensor",
+       "shape from texture: slant and tilt of a textured plane from its mean normalised structure tensor "
+       "(isotropic texture, orthographic foreshortening), tilt sign from the texture's density gradient",
+       window_px=4.0),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

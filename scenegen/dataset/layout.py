@@ -14,6 +14,9 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_ids.exr                    uint32 object_id, instance_id (0 = nothing)
     truth/<view>_valid.png                  uint8 mask, 255 where the pixel centre's ray hit
     truth/<view>_vignetting.exr             the imaging chain's vignetting map (channel V)
+    truth/<view>_albedo.exr                 diffuse albedo per pixel centre (albedo.R/G/B; spec truth.albedo)
+    truth/<view>_lights.json                the lights on in the view, camera frame (spec truth.lights)
+    truth/<view>_coc.exr                    thin-lens circle of confusion per pixel (channel coc_radius_px; truth.defocus)
     raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
     images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote
@@ -50,7 +53,7 @@ NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 MAX_NAME_LEN = 128
 #: A view name may not end like another view's suffixed files (view "a_ids" would clash with
 #: view "a"'s truth/a_ids.exr).
-RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw")
+RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw", "_albedo", "_lights", "_coc")
 MATCH_KINDS = ("synthetic", "sift")
 
 CROSSVIEW = "crossview"
@@ -139,6 +142,30 @@ VIGNETTING_CHANNEL = "V"
 def vignetting_path(view: str) -> str:
     """The imaging chain's vignetting map of a view (an extra file of the view)."""
     return VIGNETTING_TEMPLATE.format(view=check_view_name(view))
+
+
+#: Albedo and light truth of a view (written when the spec's ``truth:`` asks for them).
+ALBEDO_TEMPLATE = "truth/{view}_albedo.exr"
+LIGHTS_TEMPLATE = "truth/{view}_lights.json"
+
+
+def albedo_path(view: str) -> str:
+    """The diffuse albedo map of a view (an extra file of the view)."""
+    return ALBEDO_TEMPLATE.format(view=check_view_name(view))
+
+
+COC_TEMPLATE = "truth/{view}_coc.exr"
+COC_CHANNEL = "coc_radius_px"
+
+
+def coc_path(view: str) -> str:
+    """The thin-lens circle of confusion of a view's pixels (an extra file of the view)."""
+    return COC_TEMPLATE.format(view=check_view_name(view))
+
+
+def lights_path(view: str) -> str:
+    """The calibrated lights of a view, in its camera frame (an extra file of the view)."""
+    return LIGHTS_TEMPLATE.format(view=check_view_name(view))
 
 
 #: The raw mosaic of a view of a camera with ``imaging.raw`` (templates recorded in cameras.json).

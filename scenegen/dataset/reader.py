@@ -31,16 +31,21 @@ from scenegen.dataset.layout import (
     MESHES_DIR,
     TARGETS_DIR,
     VIGNETTING_CHANNEL,
+    COC_CHANNEL,
+    albedo_path,
     check_listed_names,
+    coc_path,
     check_rel_path,
     mesh_path,
     names_under,
+    lights_path,
     target_path,
     view_paths,
     vignetting_path,
 )
 from scenegen.dataset.journal import load_current_manifest
 from scenegen.dataset.manifest import STATUS_COMPLETE
+from scenegen.dataset.photometric import ViewLight, decode_albedo, decode_lights
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.sequence_reader import SequenceTruth
 from scenegen.dataset.stream_reader import Streams
@@ -232,6 +237,26 @@ class Dataset:
         """(H, W) float32 vignetting map of the imaging chain, or None if the camera has none."""
         rel = vignetting_path(self.check_view(view))
         return read_exr(self.path(rel))[VIGNETTING_CHANNEL] if self.has(rel) else None
+
+    def albedo(self, view: str) -> np.ndarray | None:
+        """(H, W, 3) float32 diffuse albedo per pixel centre (NaN on misses), or None when the
+        spec did not ask for it (``truth: {albedo: true}``)."""
+        rel = albedo_path(self.check_view(view))
+        return self.read(rel, lambda p: decode_albedo(read_exr(p)), f"albedo of view {view!r}") \
+            if self.has(rel) else None
+
+    def coc_radius_px(self, view: str) -> np.ndarray | None:
+        """(H, W) float32 thin-lens circle-of-confusion radius (px) of each pixel's truth point
+        (NaN on misses), or None when the spec did not ask for it (``truth: {defocus: true}``)."""
+        rel = coc_path(self.check_view(view))
+        return self.read(rel, read_exr, f"circle of confusion of view {view!r}")[COC_CHANNEL] if self.has(rel) else None
+
+    def lights(self, view: str) -> tuple[ViewLight, ...] | None:
+        """The lights on in a view, in its camera frame (:class:`scenegen.dataset.photometric.ViewLight`),
+        or None when the spec did not ask for them (``truth: {lights: true}``)."""
+        rel = lights_path(self.check_view(view))
+        return self.read(rel, lambda p: decode_lights(read_json(p), str(p)), f"lights of view {view!r}") \
+            if self.has(rel) else None
 
     def raw(self, view: str, kind: str | None = None) -> RawImage | None:
         """The raw mosaic of a view (:class:`scenegen.dataset.raw.RawImage`: uint16 DN, CFA,

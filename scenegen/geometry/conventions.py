@@ -41,6 +41,10 @@ from scenegen.geometry.rotation import matrix_from_quat_wxyz, quat_wxyz_from_mat
 MITSUBA_FROM_OPENCV_CAM = np.diag([-1.0, -1.0, 1.0])
 #: x_opengl_cam = OPENGL_FROM_OPENCV_CAM @ x_opencv_cam (x right, y up, z backward).
 OPENGL_FROM_OPENCV_CAM = np.diag([1.0, -1.0, -1.0])
+#: x_diligent_cam = DILIGENT_FROM_OPENCV_CAM @ x_opencv_cam: the photometric stereo benchmark
+#: DiLiGenT states normals (Normal_gt.mat) and light directions (light_directions.txt, unit
+#: vectors toward the light) with x right, y up, z toward the camera: OpenGL's axes.
+DILIGENT_FROM_OPENCV_CAM = OPENGL_FROM_OPENCV_CAM
 
 
 def _camera_to_world(cam_from_world: Rigid3, foreign_from_opencv: np.ndarray) -> np.ndarray:

@@ -13,7 +13,12 @@ from scenegen.geometry.color import srgb_image
 from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict
 from scenegen.geometry.rolling import RollingRows, RowPoses, frame_node_rows
 from scenegen.geometry.seeds import hashed_seed32
+from scenegen.dataset.codecs import encode_json
+from scenegen.dataset.codecs.exr import encode_exr
+from scenegen.dataset.layout import COC_CHANNEL, albedo_path, coc_path, lights_path
+from scenegen.dataset.photometric import encode_albedo
 from scenegen.imaging.stage import apply_imaging
+from scenegen.spec.light_truth import view_lights_document
 from scenegen.spec.timeline import poses_within_frame
 
 
@@ -129,7 +134,29 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
         # mosaic with imaging.raw
         image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name,
                                      camera_name=v.camera)
+    if spec.truth is not None and (spec.truth.albedo or spec.truth.lights or spec.truth.defocus):
+        extra = {**(extra or {}), **requested_truth_files(spec, built, v, truth)}
     return image, linear, truth, extra
+
+
+def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
+    """The albedo map, the lights document and the circle of confusion of a view, as the spec's
+    ``truth:`` asks (docs/dataset_format.md, "Albedo and light truth", "Defocus truth");
+    ``truth``: the view's truth as stored."""
+    files = {}
+    lens = getattr(built.optics.get(view.camera), "lens", None)
+    if spec.truth.defocus and lens is not None:  # the thin lens's blur of each pixel's truth point
+        coc = lens.blur_radius_px(built.cameras[view.camera], truth["depth_z"].astype(np.float64))
+        files[coc_path(view.name)] = encode_exr({COC_CHANNEL: np.where(truth["valid"], coc, np.nan).astype(np.float32)})
+    if spec.truth.albedo:
+        if rolling_shutter_rows(built, view) is not None or (view.motion is not None and not view.motion.is_static) \
+                or built.moving:
+            raise ValueError(f"view {view.name!r}: albedo truth is for a still camera and a static scene "
+                             "(no motion, no rolling shutter while moving)")
+        files[albedo_path(view.name)] = encode_albedo(built.albedo(built.cameras[view.camera], view.cam_from_world))
+    if spec.truth.lights:
+        files[lights_path(view.name)] = encode_json(view_lights_document(spec, view))
+    return files
 
 
 def view_optics(built, view) -> dict | None:

@@ -48,8 +48,14 @@ def _envmap(light: m.EnvmapLight) -> dict:
     return {"type": "envmap", "filename": str(light.path), "scale": float(light.scale), "to_world": T}
 
 
+def _directional(light: m.DirectionalLight) -> dict:
+    # Mitsuba's `direction` is the one the light travels in: away from the light
+    return {"type": "directional", "direction": [-float(x) for x in light.unit_direction_to_light],
+            "irradiance": rgb(light.irradiance)}
+
+
 LIGHTS = {m.AreaLight: _area, m.PointLight: _point, m.SpotLight: _spot, m.ConstantLight: _constant,
-          m.EnvmapLight: _envmap}
+          m.EnvmapLight: _envmap, m.DirectionalLight: _directional}
 
 #: Mitsuba 3.9 parameters (relative to the light's key in the scene dict) that carry a light's
 #: power: scaling one scales the light's contribution linearly (same paths, same samples).
@@ -59,6 +65,7 @@ EMITTER_POWER_PARAM = {
     m.SpotLight: "intensity.value",  # on-axis W/sr
     m.ConstantLight: "radiance.value",  # W/(m^2 sr)
     m.EnvmapLight: "scale",  # factor on the image's radiance
+    m.DirectionalLight: "irradiance.value",  # W/m^2
 }
 #: ... and its share of the light samples: Mitsuba picks the emitter of a light sample in
 #: proportion to this weight (1 by default), not to power.

@@ -15,6 +15,7 @@ import numpy as np
 
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast, sensor as sensor_mod
+from scenegen.render.albedo import albedo_pass
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.animate import animated_entry, place_animated
 from scenegen.render.frames import render_ideal, render_view
@@ -93,6 +94,10 @@ class LoadedScene:
         timed = None if row_moves is None else (self.timed(), row_moves)
         return truth_pass(self.scene, camera, cam_from_world, self.id_tables, row_poses=row_poses, as_stored=as_stored,
                           alpha_masked=self.alpha_masked, timed=timed)
+
+    def albedo(self, camera, cam_from_world: Rigid3) -> np.ndarray:
+        """(H, W, 3) float32 diffuse albedo per pixel centre (:func:`scenegen.render.albedo.albedo_pass`)."""
+        return albedo_pass(self.scene, camera, cam_from_world, self.alpha_masked)
 
     def timed(self):
         """The still world and one scene per moving object (:mod:`scenegen.render.timed`),

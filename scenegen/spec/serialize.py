@@ -115,6 +115,7 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         **({"crossview": _plain(spec.crossview)} if getattr(spec, "crossview", None) is not None else {}),
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
         **({"sequence": _plain(spec.sequence)} if getattr(spec, "sequence", None) is not None else {}),
+        **({"truth": _plain(spec.truth)} if getattr(spec, "truth", None) is not None else {}),
     }
 
 

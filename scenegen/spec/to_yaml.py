@@ -171,6 +171,8 @@ def _light(li) -> dict:
         d.update(radiance=_v(li.radiance))
     elif isinstance(li, m.EnvmapLight):
         d.update(path=li.path_as_written or str(li.path), scale=li.scale, rotation_z_deg=li.rotation_z_deg)
+    elif isinstance(li, m.DirectionalLight):
+        d.update(direction_to_light=_v(li.direction_to_light), irradiance=_v(li.irradiance))
     elif isinstance(li, m.SpotLight):
         d.update(position=_v(li.position), target=_v(li.target), intensity=_v(li.intensity),
                  cutoff_deg=li.cutoff_deg, beam_width_deg=li.beam_width_deg)
@@ -324,6 +326,8 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
         d["crossview"] = _crossview(spec.crossview)
     if spec.variation is not None:
         d["variation"] = _variation(spec.variation)
+    if spec.truth is not None:
+        d["truth"] = {"albedo": spec.truth.albedo, "lights": spec.truth.lights, "defocus": spec.truth.defocus}
     return d
 
 

@@ -92,7 +92,7 @@ def _vary_light(light, lv, seed: int, index: int, drawn: dict):
     if lv.intensity_scale is not None:
         k = float(_uniform(_rng(seed, index, path + ".intensity_scale"), *lv.intensity_scale))
         d["intensity_scale"] = k
-        for key in ("radiance", "intensity"):
+        for key in ("radiance", "intensity", "irradiance"):
             if hasattr(light, key):
                 changes[key] = tuple(k * float(c) for c in getattr(light, key))
         if isinstance(light, m.EnvmapLight):

@@ -31,8 +31,8 @@ from scenegen.spec.model.geometry import (
     Torus, Transform,
 )
 from scenegen.spec.model.lights import (
-    BEAM_WIDTH_FRACTION, LIGHT_TYPES, AreaLight, ConstantLight, EnvmapLight, Light, PointLight,
-    SpotLight,
+    BEAM_WIDTH_FRACTION, LIGHT_TYPES, AreaLight, ConstantLight, DirectionalLight, EnvmapLight, Light,
+    PointLight, SpotLight,
 )
 from scenegen.spec.model.materials import (
     CONDUCTOR_NAMES, IMAGE_SUFFIXES, MATERIAL_TYPES, PROCEDURAL_TEXTURE_KINDS, TEXTURE_KINDS,
@@ -47,6 +47,7 @@ from scenegen.spec.model.scene import SceneSpec
 from scenegen.spec.model.timeline import (
     Animation, JointKeyframe, JointSpec, Keyframe, SequenceSpec, TrackSpec, TrajectorySpec,
 )
+from scenegen.spec.model.truth import TruthSpec
 from scenegen.spec.model.variation import (
     CameraVariation, LightVariation, ObjectVariation, PoseJitter, VariationSpec,
 )
@@ -62,7 +63,7 @@ __all__ = [
     "Box", "CharucoTarget", "CheckerboardTarget", "Cylinder", "Mesh", "Plane", "SceneObject",
     "Shape", "Sphere", "Target", "Torus", "Transform",
     "BEAM_WIDTH_FRACTION", "LIGHT_TYPES", "AreaLight", "ConstantLight", "EnvmapLight", "Light",
-    "PointLight", "SpotLight",
+    "PointLight", "SpotLight", "DirectionalLight",
     "CONDUCTOR_NAMES", "IMAGE_SUFFIXES", "MATERIAL_TYPES", "PROCEDURAL_TEXTURE_KINDS",
     "TEXTURE_KINDS", "ConductorMaterial", "DielectricMaterial", "DiffuseMaterial", "Material",
     "PlasticMaterial", "PrincipledMaterial", "SurfaceMaps", "Texture", "ThinDielectricMaterial",
@@ -73,6 +74,7 @@ __all__ = [
     "SceneSpec",
     "Animation", "JointKeyframe", "JointSpec", "Keyframe", "SequenceSpec", "TrackSpec",
     "TrajectorySpec",
+    "TruthSpec",
     "CameraVariation", "LightVariation", "ObjectVariation", "PoseJitter", "VariationSpec",
     "CirclePath", "LinePath", "LookAt", "LookAtList", "Orbit", "Placement", "PoseList",
     "RandomPoses", "TrajectoryPath", "View", "ViewSet",

@@ -1,6 +1,7 @@
 """Lights (radiance in W/(m^2 sr), intensity in W/sr, linear RGB)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Union
@@ -9,7 +10,7 @@ from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec.model.meta import param, part, where_field
 
-LIGHT_TYPES = ("area", "point", "spot", "constant", "envmap")
+LIGHT_TYPES = ("area", "point", "spot", "constant", "envmap", "directional")
 #: A spot's default full-intensity half-angle, as a fraction of its cutoff.
 BEAM_WIDTH_FRACTION = 0.75
 _NAME = "name, unique among lights"
@@ -78,4 +79,24 @@ class EnvmapLight:
     type: str = field(default="envmap", init=False)
 
 
-Light = Union[AreaLight, PointLight, SpotLight, ConstantLight, EnvmapLight]
+@dataclass(frozen=True, kw_only=True)
+class DirectionalLight:
+    """A light at infinity (the sun, or photometric stereo's distant lights): parallel rays."""
+
+    name: str = param(unit=_NAME, derived=_DEFAULT_NAME)
+    direction_to_light: tuple[float, float, float] = param(unit="world direction from the scene "
+                                                                "toward the light (any length "
+                                                                "> 0)")
+    irradiance: tuple[float, float, float] = param(unit="linear RGB, W/m^2 on a surface facing "
+                                                        "the light", lo=0.0)
+    where: Where | None = where_field()
+    type: str = field(default="directional", init=False)
+
+    @property
+    def unit_direction_to_light(self) -> tuple[float, float, float]:
+        """``direction_to_light`` scaled to unit length."""
+        n = math.sqrt(sum(float(x) ** 2 for x in self.direction_to_light))
+        return tuple(float(x) / n for x in self.direction_to_light)  # type: ignore[return-value]
+
+
+Light = Union[AreaLight, PointLight, SpotLight, ConstantLight, EnvmapLight, DirectionalLight]

@@ -12,6 +12,7 @@ from scenegen.spec.model.lights import Light
 from scenegen.spec.model.materials import Material
 from scenegen.spec.model.meta import SEED_MAX, frozen_mapping, param, part
 from scenegen.spec.model.render import RenderSettings
+from scenegen.spec.model.truth import TruthSpec
 from scenegen.spec.model.variation import VariationSpec
 from scenegen.spec.model.views import ViewSet
 
@@ -39,6 +40,8 @@ class SceneSpec:
                                                       "--variants N`; None = none declared")
     sequence: Any = part(None, unit="scenegen.spec.model.timeline.SequenceSpec: the clock of a "
                                     "sequence; None = a static scene")
+    truth: TruthSpec | None = part(None, unit="per-view truth written on request (albedo, "
+                                             "lights); None = none", omit_default=True)
     variant: Mapping[str, Any] | None = part(None, unit="a derived variant's index, seed and "
                                                         "drawn values "
                                                         "(scenegen.spec.variants.derive_variant); "

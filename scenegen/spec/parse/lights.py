@@ -1,5 +1,7 @@
-"""``lights:``: area, point, spot, constant (environment) and envmap lights."""
+"""``lights:``: area, point, spot, constant (environment), envmap and directional lights."""
 from __future__ import annotations
+
+import math
 
 from scenegen.assets.checks import ENVMAP_SUFFIXES
 from scenegen.located_yaml import Node
@@ -16,11 +18,14 @@ KEYS = {
     "spot": ("position", "target", "intensity", "cutoff_deg", "beam_width_deg"),
     "constant": ("radiance",),
     "envmap": ("path", "scale", "rotation_z_deg"),
+    "directional": ("direction_to_light", "irradiance"),
 }
 REQUIRED = {"point": ("position", "intensity"), "spot": ("position", "target", "intensity"),
-            "constant": ("radiance",), "envmap": ("path",), "area": ("radiance",)}
+            "constant": ("radiance",), "envmap": ("path",), "area": ("radiance",),
+            "directional": ("direction_to_light", "irradiance")}
 CLASSES = {"area": ml.AreaLight, "point": ml.PointLight, "spot": ml.SpotLight,
-           "constant": ml.ConstantLight, "envmap": ml.EnvmapLight}
+           "constant": ml.ConstantLight, "envmap": ml.EnvmapLight,
+           "directional": ml.DirectionalLight}
 
 
 def default_light_name(index: int) -> str:
@@ -37,6 +42,13 @@ def parse_light(node: Node, index: int, ctx: ParseContext) -> ml.Light:
     if kind == "point":
         return C(name=name, position=read_vec3(f, C, "position"),
                  intensity=read_color(f.get("intensity"), C, "intensity"), where=w)
+    if kind == "directional":
+        d = read_vec3(f, C, "direction_to_light")
+        norm = math.sqrt(sum(x * x for x in d))
+        if not norm > 0:
+            raise f.get("direction_to_light").error("expected a non-zero direction [x, y, z], got [0, 0, 0]")
+        return C(name=name, direction_to_light=d,
+                 irradiance=read_color(f.get("irradiance"), C, "irradiance"), where=w)
     if kind == "constant":
         return C(name=name, where=w, radiance=read_color(f.get("radiance"), C, "radiance"))
     if kind == "envmap":

@@ -22,12 +22,13 @@ from scenegen.spec.parse.read import read_int
 from scenegen.spec.parse.render import parse_render
 from scenegen.spec.parse.rigs import parse_rig
 from scenegen.spec.parse.timeline import check_sequence, parse_sequence
+from scenegen.spec.parse.truth import parse_truth
 from scenegen.spec.parse.variation import parse_variation
 from scenegen.spec.parse.views import parse_view_set
 from scenegen.spec.views import resolve_views
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview", "variation", "sequence")
+                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth")
 #: Scene name of spec text that comes from no file.
 TEXT_SCENE_NAME = "scene"
 
@@ -67,11 +68,19 @@ def parse_document(doc: Document) -> SceneSpec:
     crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
+    truth = parse_truth(f.get("truth"), ctx) if "truth" in f else None
     spec = SceneSpec(
         name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
         rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
-        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence)
+        warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
+        truth=truth)
+    if truth is not None and truth.albedo:
+        moving = [o.name for o in objects if o.motion is not None and not o.motion.is_static] + \
+                 [vs.prefix for vs in view_sets if vs.motion is not None and not vs.motion.is_static]
+        if moving:
+            raise f.get("truth").as_mapping().get("albedo").error(
+                f"albedo truth is for a still camera over a static scene; {moving[0]!r} moves (`motion:`)")
     check_finite(spec)  # derived numbers too (k / fps): nothing infinite reaches the renderer or the JSON
     views = resolve_views(spec)  # degenerate placements are errors now, not at render time
     if sequence is not None:

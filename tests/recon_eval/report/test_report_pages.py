@@ -115,7 +115,8 @@ def test_one_failed_invocation_is_one_row_and_the_inputs_are_words_not_reprs():
     ("n_points3d", True), ("cloud_precision_at_1cm", True), ("fx_rel_err", False), ("synthetic.floor.mace_px", False),
     ("views_used_ratio", True), ("abs_median_signed_err_px", False), ("sigma1.median_rel_err", False),
     ("localisation_err_px", False), ("calib_rms_px", False), ("median_signed_err_px", None),
-    ("description", None),
+    ("description", None), ("lambertian.within_10deg", True), ("all.albedo_rel_mae", False), ("coverage", True),
+    ("lambertian.mean_ae_deg", False),
 ])
 def test_direction_of_the_leaderboard_metrics(metric, higher):
     assert higher_is_better(metric) is higher

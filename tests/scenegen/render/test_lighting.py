@@ -118,7 +118,8 @@ def test_emitter_power_keys_cover_every_light_type(built):  # built: Mitsuba loa
     from scenegen.render.lights import EMITTER_POWER_PARAM
     from scenegen.spec import model as m
 
-    assert set(EMITTER_POWER_PARAM) == {m.AreaLight, m.PointLight, m.SpotLight, m.ConstantLight, m.EnvmapLight}
+    assert set(EMITTER_POWER_PARAM) == {m.AreaLight, m.PointLight, m.SpotLight, m.ConstantLight, m.EnvmapLight,
+                                        m.DirectionalLight}
 
 
 @pytest.mark.render
