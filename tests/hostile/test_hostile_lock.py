@@ -171,6 +171,21 @@ def test_an_unreadable_lock_file_is_reported_not_broken(tmp_path, no_flock):
 
 
 KILLED = TINY.replace("count: 2}", "count: 24}")
+# The render under test pauses after each journal record of its views (a tiny view takes
+# milliseconds: 24 of them, on 2 Dask workers, could all be recorded and the run finished between
+# two looks at the journal), so the kill lands while the run is alive with views recorded. A pause
+# changes no byte.
+PAUSE_AFTER_RECORDING = """
+import sys, time
+from scenegen.dataset.writer import DatasetWriter
+for name in ("record_view", "record_views"):
+    def paused(self, *a, _real=getattr(DatasetWriter, name), **kw):
+        _real(self, *a, **kw)
+        time.sleep(0.3)
+    setattr(DatasetWriter, name, paused)
+from scenegen.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
 
 
 @pytest.mark.render
@@ -183,7 +198,7 @@ def test_kill_9_mid_render_then_resume_takes_over_the_stale_lock_and_gives_the_b
     ref = tmp_path / "ref"
     assert main(["render", str(spec), "-o", str(ref), "-q"]) == 0
     out = tmp_path / "out"
-    argv = [sys.executable, "-m", "scenegen.cli", "render", str(spec), "-o", str(out), "-q"]
+    argv = [sys.executable, "-c", PAUSE_AFTER_RECORDING, "render", str(spec), "-o", str(out), "-q"]
     if workers:
         argv += ["--workers", str(workers)]
     p = subprocess.Popen(argv, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True,
