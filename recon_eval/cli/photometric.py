@@ -4,8 +4,6 @@ objects; optionally the method's albedo (up to the global scale) and, for uncali
 stereo, its light directions and intensities (docs/metrics.md, "Photometric stereo")."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from recon_eval.cli.scored import no_figures, scored

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from scenegen.assets import blob, cache, meshes, shapes, textures
+from scenegen.assets import blob, cache, meshes, textures
 from scenegen.spec import parse_spec
 
 SPEC = """

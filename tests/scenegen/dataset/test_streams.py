@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from scenegen import dataset as ds
-from scenegen.dataset.codecs import decode_npz, encode_npz
+from scenegen.dataset.codecs import decode_npz
 from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.streams import StreamField, StreamSchema, encode_chunk
 
