@@ -119,3 +119,43 @@ SEQUENCE_SCENE = AnalyticScene(
     boxes={"crate": (0.15, 0.1, 0.125), "dice": (0.075, 0.075, 0.075)},
     visible={"dice": (0.15, 1.0)},
     ids={"floor": 1, "ball": 2, "crate": 3, "dice": 4})
+
+
+@dataclass
+class RollingPinhole:
+    """The tests' own rolling-shutter pinhole: W x H pixels, focal ``f`` px, principal point at the
+    image centre, rows exposed at ``t_frame + readout_s (v / (H - 1) - 0.5)``, the camera on the
+    keyframed path ``path`` (slerp_lerp's arguments: world_from_cam rotations and centres)."""
+
+    W: int
+    H: int
+    f: float
+    readout_s: float
+    path: tuple
+
+    def row_time(self, t_frame, v):
+        return t_frame + self.readout_s * (np.asarray(v, float) / (self.H - 1) - 0.5)
+
+    def pose(self, t):
+        """((N, 3, 3) world_from_cam rotations, (N, 3) centres) at times ``t`` (N,)."""
+        return slerp_lerp(t, *self.path)
+
+    def project(self, P, t):
+        """((N, 2) pixels, (N,) depth) of points P (N, 3) with the camera at times ``t`` (N,)."""
+        R, C = self.pose(t)
+        Pc = np.einsum("nji,nj->ni", R, P - C)
+        cx, cy = (self.W - 1) / 2, (self.H - 1) / 2
+        return np.stack([self.f * Pc[:, 0] / Pc[:, 2] + cx, self.f * Pc[:, 1] / Pc[:, 2] + cy], 1), Pc[:, 2]
+
+    def frame_points(self, scene: AnalyticScene, t_frame):
+        """Per pixel of a frame: (N, 3) surface points, (N,) ids, (N,) times of their rows, (N,)
+        distances along the rays (each ray cast at its row's time)."""
+        u, v = np.meshgrid(np.arange(self.W, dtype=float), np.arange(self.H, dtype=float))
+        t = self.row_time(t_frame, v.reshape(-1))
+        cx, cy = (self.W - 1) / 2, (self.H - 1) / 2
+        d = np.stack([(u - cx) / self.f, (v - cy) / self.f, np.ones_like(u)], -1).reshape(-1, 3)
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        R, C = self.pose(t)
+        dw = np.einsum("nij,nj->ni", R, d)
+        s, ids = scene.first_hits(C, dw, t)
+        return C + s[:, None] * dw, ids, t, s

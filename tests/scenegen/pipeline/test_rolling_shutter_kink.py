@@ -17,13 +17,12 @@ from scenegen.dataset.codecs import read_exr
 from scenegen.pipeline.run import render_spec
 
 sys.path.insert(0, str(Path(__file__).parent))
-from analytic_scene import AnalyticScene, look, slerp_lerp  # noqa: E402
+from analytic_scene import AnalyticScene, RollingPinhole, look  # noqa: E402
 
 pytestmark = [pytest.mark.render, pytest.mark.filterwarnings("ignore:invalid value:RuntimeWarning"),
               pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning")]
 
 W, H, F = 80, 60, 70.0
-CX, CY = (W - 1) / 2, (H - 1) / 2
 TIMES = [0.0, 0.1, 0.2, 0.3]
 READOUT = 0.03
 TOL_FLOW_PX = 2e-4  # as tests/scenegen/pipeline/test_rolling_shutter_truth.py (float32 storage)
@@ -54,39 +53,22 @@ views:
 """
 SCENE = AnalyticScene(paths={"ball": (0.0, 0.3, np.eye(3), np.eye(3), [-0.5, 0.2, 0.25], [0.5, -0.2, 0.35])},
                       ids={"floor": 1, "ball": 2})
-CAM_PATH = (0.0, 0.3, look([0.55, -1.9, 1.2], [0, 0, 0.1]), look([-0.55, -1.7, 1.3], [0, 0.05, 0.1]),
-            [0.55, -1.9, 1.2], [-0.55, -1.7, 1.3])
-
-
-def row_time(t_frame, v):
-    return t_frame + READOUT * (np.asarray(v, float) / (H - 1) - 0.5)
-
-
-def project(P, t):
-    R, C = slerp_lerp(t, *CAM_PATH)
-    Pc = np.einsum("nji,nj->ni", R, P - C)
-    return np.stack([F * Pc[:, 0] / Pc[:, 2] + CX, F * Pc[:, 1] / Pc[:, 2] + CY], 1), Pc[:, 2]
+CAM = RollingPinhole(W, H, F, READOUT, (0.0, 0.3, look([0.55, -1.9, 1.2], [0, 0, 0.1]),
+                                        look([-0.55, -1.7, 1.3], [0, 0.05, 0.1]), [0.55, -1.9, 1.2], [-0.55, -1.7, 1.3]))
 
 
 def frame_points(t_frame):
     """Per pixel: (N, 3) surface points, (N,) ids, (N,) row times."""
-    u, v = np.meshgrid(np.arange(W, dtype=float), np.arange(H, dtype=float))
-    t = row_time(t_frame, v.reshape(-1))
-    d = np.stack([(u - CX) / F, (v - CY) / F, np.ones_like(u)], -1).reshape(-1, 3)
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    R, C = slerp_lerp(t, *CAM_PATH)
-    dw = np.einsum("nij,nj->ni", R, d)
-    s, ids = SCENE.first_hits(C, dw, t)
-    return C + s[:, None] * dw, ids, t
+    return CAM.frame_points(SCENE, t_frame)[:3]
 
 
 def imaged(P_a, ids, t_a, t_frame):
     """(N, 2) pixels and (N, 3) world points where frame t_frame images the points P_a (seen at
     times t_a): bisection on g(v) = row(point at time(v)) - v; NaN where no row in the frame."""
     def at(v):
-        t = row_time(t_frame, v)
+        t = CAM.row_time(t_frame, v)
         P = SCENE.moved(P_a, ids, t_a, t)
-        uv, z = project(P, t)
+        uv, z = CAM.project(P, t)
         return uv, P, np.where(z > 0, uv[:, 1] - v, np.nan)
     a, b = np.full(len(P_a), -0.5), np.full(len(P_a), H - 0.5)
     ok = (at(a)[2] > 0) & (at(b)[2] < 0)

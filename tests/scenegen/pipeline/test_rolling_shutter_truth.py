@@ -22,7 +22,7 @@ from scenegen.dataset.crossview import NO_SURFACE, OCCLUDED, OUT_OF_FRAME, VISIB
 from scenegen.pipeline.run import render_spec
 
 sys.path.insert(0, str(Path(__file__).parent))
-from analytic_scene import AnalyticScene, euler_deg, look, slerp_lerp  # noqa: E402
+from analytic_scene import AnalyticScene, RollingPinhole, euler_deg, look  # noqa: E402
 
 pytestmark = [pytest.mark.render, pytest.mark.filterwarnings("ignore:invalid value:RuntimeWarning"),
               pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning")]
@@ -79,6 +79,7 @@ SCENE = AnalyticScene(  # the spec's objects, restated (tests/scenegen/pipeline/
 IDS = SCENE.ids
 CAM_PATH = (-0.1, 0.3, look([0.4, -1.85, 1.25], [0, -0.025, 0.1]), look([-0.4, -1.65, 1.45], [0, 0.075, 0.1]),
             [0.4, -1.85, 1.25], [-0.4, -1.65, 1.45])
+CAM = RollingPinhole(W, H, F, READOUT, CAM_PATH)
 
 
 def world_from(name, t):
@@ -88,11 +89,11 @@ def world_from(name, t):
 
 def camera(t):
     """(N, 3, 3) world_from_cam rotations and (N, 3) centres at times t (N,)."""
-    return slerp_lerp(t, *CAM_PATH)
+    return CAM.pose(t)
 
 
 def row_time(t_frame, v):
-    return t_frame + READOUT * (np.asarray(v, float) / (H - 1) - 0.5)
+    return CAM.row_time(t_frame, v)
 
 
 def first_hits(o, d, t):
@@ -102,21 +103,12 @@ def first_hits(o, d, t):
 
 def project(P, t):
     """Own pinhole: (N, 2) pixels and (N,) depth of points P (N, 3) with the camera at times t (N,)."""
-    R, C = camera(t)
-    Pc = np.einsum("nji,nj->ni", R, P - C)
-    return np.stack([F * Pc[:, 0] / Pc[:, 2] + CX, F * Pc[:, 1] / Pc[:, 2] + CY], 1), Pc[:, 2]
+    return CAM.project(P, t)
 
 
 def frame_points(t_frame):
     """Per pixel of a frame: (N, 3) surface points, (N,) ids, (N,) times of their rows."""
-    u, v = np.meshgrid(np.arange(W, dtype=float), np.arange(H, dtype=float))
-    t = row_time(t_frame, v.reshape(-1))
-    d = np.stack([(u - CX) / F, (v - CY) / F, np.ones_like(u)], -1).reshape(-1, 3)
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    R, C = camera(t)
-    dw = np.einsum("nij,nj->ni", R, d)
-    s, ids = first_hits(C, dw, t)
-    return C + s[:, None] * dw, ids, t, s
+    return CAM.frame_points(SCENE, t_frame)
 
 
 def to_object(P, ids, t):
