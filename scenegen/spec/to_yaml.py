@@ -23,7 +23,9 @@ from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.imaging import ImagingParams
 from scenegen.spec import model as m
 from scenegen.spec.load import parse_spec
+from scenegen.spec.parse.fields import written_fields
 from scenegen.spec.parse.imaging import BLOCKS
+from scenegen.spec.parse.optics import OPTICS_KEYS
 from scenegen.spec.parse.materials import TYPE_KEYS as MATERIAL_KEYS
 from scenegen.spec.serialize import spec_to_dict
 
@@ -50,6 +52,14 @@ def _matrix(pose) -> dict:
 
 def _fields(obj, names) -> dict:
     return {n: _v(getattr(obj, n)) for n in names}
+
+
+def _record(obj, skip=()) -> dict:
+    """The written fields of a spec record under their YAML keys (generated from the field
+    metadata, :func:`scenegen.spec.parse.fields.written_fields`); None values left out (absent
+    means None or the value derived from the others)."""
+    return {fi.key: _v(getattr(obj, fi.name)) for fi in written_fields(type(obj), skip)
+            if getattr(obj, fi.name) is not None}
 
 
 def _texture(t: m.Texture) -> dict:
@@ -101,10 +111,6 @@ def _geometry(g) -> tuple[str, Any]:
     return "shape", {"type": g.kind, **_fields(g, names)}
 
 
-def _motion(mo) -> dict:
-    return _fields(mo, ("linear_velocity_mps", "angular_velocity_deg_s"))
-
-
 def _object(obj: m.SceneObject, materials) -> dict:
     key, geo = _geometry(obj.geometry)
     d: dict[str, Any] = {"name": obj.name, key: geo,
@@ -116,7 +122,7 @@ def _object(obj: m.SceneObject, materials) -> dict:
         d["material"] = mat.name if named else _material(mat)
     d["instance_id"] = obj.instance_id
     if obj.motion is not None:
-        d["motion"] = _motion(obj.motion)
+        d["motion"] = _record(obj.motion)
     if obj.animation is not None:
         d.update(_animation(obj.animation, _v(obj.transform.scale)))
         if obj.animation.trajectory is not None:  # the keyframes place it; `transform` scales only
@@ -165,34 +171,21 @@ def _sequence(q: m.SequenceSpec) -> dict:
 
 def _light(li) -> dict:
     d: dict[str, Any] = {"name": li.name, "type": li.type} if li.name is not None else {"type": li.type}
-    if isinstance(li, m.PointLight):
-        d.update(position=_v(li.position), intensity=_v(li.intensity))
-    elif isinstance(li, m.ConstantLight):
-        d.update(radiance=_v(li.radiance))
-    elif isinstance(li, m.EnvmapLight):
-        d.update(path=li.path_as_written or str(li.path), scale=li.scale, rotation_z_deg=li.rotation_z_deg)
-    elif isinstance(li, m.DirectionalLight):
-        d.update(direction_to_light=_v(li.direction_to_light), irradiance=_v(li.irradiance))
-    elif isinstance(li, m.SpotLight):
-        d.update(position=_v(li.position), target=_v(li.target), intensity=_v(li.intensity),
-                 cutoff_deg=li.cutoff_deg, beam_width_deg=li.beam_width_deg)
-    else:
-        d.update(size=_v(li.size), radiance=_v(li.radiance), transform=_matrix(li.world_from_light))
+    d.update(_record(li, ("name",)))
+    if isinstance(li, m.EnvmapLight):
+        d["path"] = li.path_as_written or str(li.path)
+    elif isinstance(li, m.AreaLight):
+        d["transform"] = _matrix(li.world_from_light)
     return d
 
 
 def _imaging(p: ImagingParams) -> dict:
-    d: dict[str, Any] = {}
-    if p.preset is not None:
-        d["preset"] = p.preset
-    for block, readers in BLOCKS.items():
-        part = getattr(p, block)
-        d[block] = {k: _v(getattr(part, k)) for k in readers if getattr(part, k) is not None}
+    d: dict[str, Any] = {"preset": p.preset} if p.preset is not None else {}
+    d.update({block: _record(getattr(p, block)) for block in BLOCKS})
+    d.update(_record(p, ("preset",)))
     d["bayer"] = p.bayer if p.bayer is not None else "none"
-    d["demosaic"] = p.demosaic
     d["white_balance"] = _v(p.white_balance) if p.white_balance is not None else "auto"
-    d.update(response=p.response, gamma=p.gamma, bit_depth=p.bit_depth)
-    d["raw"] = False if p.raw is None else {f.name: getattr(p.raw, f.name) for f in dataclasses.fields(p.raw)}
+    d["raw"] = False if p.raw is None else _record(p.raw)
     return d
 
 
@@ -207,12 +200,9 @@ def _camera(c: m.CameraSpec) -> dict:
         d["mask_beyond_fold"] = True
     o = c.optics
     if o is not None:
-        if o.lens is not None:
-            d["lens"] = _fields(o.lens, ("f_number", "focus_distance_m", "pixel_pitch_um"))
-        if o.shutter is not None:
-            d["shutter"] = _fields(o.shutter, ("exposure_s", "rolling_readout_s"))
-        if o.chromatic_aberration is not None:
-            d["chromatic_aberration"] = _fields(o.chromatic_aberration, ("red_focal_scale", "blue_focal_scale"))
+        for key in OPTICS_KEYS:
+            if getattr(o, key) is not None:
+                d[key] = _record(getattr(o, key))
     if c.imaging is not None:
         d["imaging"] = _imaging(c.imaging)
     return d
@@ -258,7 +248,7 @@ def _view_set(vs: m.ViewSet) -> dict:
     key, val = _placement(vs.placement, "rig" if vs.rig else "cam")
     d[key] = val
     if vs.motion is not None:
-        d["motion"] = _motion(vs.motion)
+        d["motion"] = _record(vs.motion)
     if vs.lights is not None:
         d["lights"] = {k: float(v) for k, v in vs.lights.items()}
     return d
@@ -306,8 +296,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     if spec.variant is not None:
         raise ValueError("a derived variant has no YAML of its own; write the spec it came from")
     d: dict[str, Any] = {"name": spec.name, "description": spec.description, "seed": spec.seed,
-                         "render": _fields(spec.render, [f.name for f in dataclasses.fields(spec.render)
-                                                         if f.name != "where"])}
+                         "render": _record(spec.render)}
     if spec.sequence is not None:
         d["sequence"] = _sequence(spec.sequence)
     if spec.materials:

@@ -26,7 +26,7 @@ class AreaLight:
     # rectangle side lengths along the light's x and y
     world_from_light: Rigid3 = part(unit="the rectangle lies in the light's z = 0 plane and "
                                          "emits toward +z")
-    radiance: tuple[float, float, float] = param(unit=_RADIANCE, lo=0.0)  # emitted radiance
+    radiance: tuple[float, float, float] = param(unit=_RADIANCE, lo=0.0, kind="color")  # emitted radiance
     where: Where | None = where_field()
     type: str = field(default="area", init=False)
 
@@ -35,7 +35,7 @@ class AreaLight:
 class PointLight:
     name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
     position: tuple[float, float, float] = param(unit="metres")  # world
-    intensity: tuple[float, float, float] = param(unit=_INTENSITY, lo=0.0)  # radiant intensity
+    intensity: tuple[float, float, float] = param(unit=_INTENSITY, lo=0.0, kind="color")  # radiant intensity
     where: Where | None = where_field()
     type: str = field(default="point", init=False)
 
@@ -47,7 +47,7 @@ class SpotLight:
     target: tuple[float, float, float] = param(unit="metres")  # point the spot's axis passes
     # through, world
     world_from_light: Rigid3 = part(unit="light frame: origin at position, +z toward target")
-    intensity: tuple[float, float, float] = param(unit=_INTENSITY, lo=0.0)  # on-axis radiant
+    intensity: tuple[float, float, float] = param(unit=_INTENSITY, lo=0.0, kind="color")  # on-axis radiant
     # intensity
     cutoff_deg: float = param(20.0, unit="degrees", lo=0.0, lo_open=True, hi=90.0)  # half-angle
     # of the cone
@@ -61,7 +61,7 @@ class SpotLight:
 @dataclass(frozen=True, kw_only=True)
 class ConstantLight:
     name: str | None = param(None, unit=_NAME, derived=_DEFAULT_NAME)  # None: set by the parser / Scene()
-    radiance: tuple[float, float, float] = param(unit=_RADIANCE, lo=0.0)  # uniform environment
+    radiance: tuple[float, float, float] = param(unit=_RADIANCE, lo=0.0, kind="color")  # uniform environment
     where: Where | None = where_field()
     type: str = field(default="constant", init=False)
 
@@ -88,7 +88,7 @@ class DirectionalLight:
                                                                 "toward the light (any length "
                                                                 "> 0)")
     irradiance: tuple[float, float, float] = param(unit="linear RGB, W/m^2 on a surface facing "
-                                                        "the light", lo=0.0)
+                                                        "the light", lo=0.0, kind="color")
     where: Where | None = where_field()
     type: str = field(default="directional", init=False)
 

@@ -13,8 +13,10 @@ their metadata with :func:`describe_foreign`, their defaults staying where they 
 from __future__ import annotations
 
 import dataclasses
+import functools
+import types
+import typing
 from dataclasses import MISSING, dataclass, field
-from types import MappingProxyType
 from typing import Any, Mapping
 
 #: Key of the spec metadata in ``dataclasses.Field.metadata``.
@@ -57,6 +59,12 @@ class Meta:
     # say it (e.g. 'required for a stereo rig')
     omit_default: bool = False  # left out of the resolved spec (spec_to_dict) while at its
     # default: a field added after datasets existed, so that theirs keep their bytes and hash
+    key: str | None = None  # the YAML key where it differs from the field name; one with '.',
+    # '[' or ' ' is a path into a value the section's own code reads (e.g. 'size[0]')
+    kind: str | None = None  # how the value is read where the type does not say it: 'color'
+    # (a grey number or 3 numbers), 'str'; else from the annotation (see value_kind)
+    count: Any = None  # allowed lengths of a list (an int, a tuple of ints, or None: any)
+    # where the tuple annotation does not fix it
 
     @property
     def shown(self) -> str:
@@ -80,11 +88,14 @@ def _number(x) -> str:
 def param(default: Any = MISSING, *, unit: str, label: str | None = None, lo=None, hi=None,
           lo_open: bool = False, hi_open: bool = False, choices=None, derived: str | None = None,
           yaml_default: Any = NOT_GIVEN, doc_default: str | None = None,
-          default_factory: Any = MISSING, omit_default: bool = False):
-    """A dataclass field for one spec value: its default and :class:`Meta`."""
+          default_factory: Any = MISSING, omit_default: bool = False, key: str | None = None,
+          kind: str | None = None, count: Any = None):
+    """A dataclass field for one spec value: its default and :class:`Meta`. Parsing, writing
+    back (``to_yaml``) and the docs' reference row of a value are generated from these."""
     meta = Meta(unit=unit, label=label, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open,
                 choices=tuple(choices) if choices is not None else None, derived=derived,
-                yaml_default=yaml_default, doc_default=doc_default, omit_default=omit_default)
+                yaml_default=yaml_default, doc_default=doc_default, omit_default=omit_default,
+                key=key, kind=kind, count=count)
     return field(default=default, default_factory=default_factory, metadata={META_KEY: meta})
 
 
@@ -103,7 +114,7 @@ def where_field():
 
 def frozen_mapping(d: Mapping | None = None) -> Mapping:
     """A read-only view of a dict (insertion order kept)."""
-    return MappingProxyType(dict(d or {}))
+    return types.MappingProxyType(dict(d or {}))
 
 
 _FOREIGN: dict[type, dict[str, Meta]] = {}
@@ -137,6 +148,22 @@ class FieldInfo:
     def required(self) -> bool:
         return self.default is MISSING and self.meta.derived is None
 
+    @property
+    def key(self) -> str:
+        """The YAML key."""
+        return self.meta.key or self.name
+
+    @property
+    def plain(self) -> bool:
+        """One YAML value under its own key, read and written by the generated code (not a part,
+        not derived from other values, not a path into a nested value)."""
+        return (not self.meta.part and self.meta.derived is None
+                and not any(c in self.key for c in ".[ "))
+
+    @property
+    def kind(self) -> str:
+        return value_kind(self.owner, self.name)
+
 
 def spec_meta(cls: type, f: dataclasses.Field) -> Meta | None:
     """The spec metadata of field ``f`` of ``cls`` (its own, or described with
@@ -164,6 +191,48 @@ def field_info(cls: type, name: str) -> FieldInfo:
     else:
         default = MISSING
     return FieldInfo(owner=cls, name=name, meta=meta_, default=default)
+
+
+_SCALARS = {float: "float", int: "int", bool: "bool", str: "str"}
+
+
+@functools.lru_cache(maxsize=None)
+def _hints(cls: type) -> dict:
+    return typing.get_type_hints(cls)
+
+
+def value_kind(cls: type, name: str) -> str:
+    """How field ``name`` of ``cls`` is read: 'enum' (it has choices), the Meta's ``kind``, else
+    from its annotation (None allowed aside): 'float', 'int', 'bool', 'str', or 'floats' for a
+    tuple of floats (its length from the annotation, or Meta.count)."""
+    m = field_info(cls, name).meta
+    if m.choices:
+        return "enum"
+    if m.kind:
+        return m.kind
+    hint = _hints(cls)[name]
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    if typing.get_origin(hint) in (typing.Union, types.UnionType) and len(args) == 1:
+        hint = args[0]
+    if hint in _SCALARS:
+        return _SCALARS[hint]
+    if typing.get_origin(hint) is tuple and set(typing.get_args(hint)) <= {float, Ellipsis}:
+        return "floats"
+    raise TypeError(f"{cls.__name__}.{name}: no reader for {hint!r}; give param(kind=...) or "
+                    "read it in the section's parser")
+
+
+def value_count(cls: type, name: str):
+    """Allowed lengths of a 'floats' field: Meta.count, else the tuple annotation's."""
+    m = field_info(cls, name).meta
+    if m.count is not None:
+        return m.count
+    hint = _hints(cls)[name]
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        hint = args[0]
+    elems = typing.get_args(hint)
+    return None if Ellipsis in elems else len(elems)
 
 
 def spec_fields(cls: type) -> list[FieldInfo]:

@@ -9,20 +9,13 @@ from scenegen.spec.model import lights as ml
 from scenegen.spec.model.meta import WORLD_UP
 from scenegen.spec.model.views import LookAt
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_color, read_float, read_floats, read_vec3
+from scenegen.spec.parse.fields import read_fields, required_keys, yaml_keys
+from scenegen.spec.parse.read import read_float, read_vec3
 from scenegen.spec.parse.transforms import POSE_KEYS, aim, parse_rigid
 
-KEYS = {
-    "area": ("size", "radiance", "transform", "position", "look_at", "up"),
-    "point": ("position", "intensity"),
-    "spot": ("position", "target", "intensity", "cutoff_deg", "beam_width_deg"),
-    "constant": ("radiance",),
-    "envmap": ("path", "scale", "rotation_z_deg"),
-    "directional": ("direction_to_light", "irradiance"),
-}
-REQUIRED = {"point": ("position", "intensity"), "spot": ("position", "target", "intensity"),
-            "constant": ("radiance",), "envmap": ("path",), "area": ("radiance",),
-            "directional": ("direction_to_light", "irradiance")}
+#: Keys read by hand besides the generated ones (those of the light's dataclass fields).
+EXTRA_KEYS = {"area": ("transform", "position", "look_at", "up"), "envmap": ("path",)}
+EXTRA_REQUIRED = {"envmap": ("path",)}
 CLASSES = {"area": ml.AreaLight, "point": ml.PointLight, "spot": ml.SpotLight,
            "constant": ml.ConstantLight, "envmap": ml.EnvmapLight,
            "directional": ml.DirectionalLight}
@@ -35,36 +28,27 @@ def default_light_name(index: int) -> str:
 def parse_light(node: Node, index: int, ctx: ParseContext) -> ml.Light:
     f = node.as_mapping("a light (a mapping with 'type')")
     kind = f.req("type").as_enum(ml.LIGHT_TYPES, "light type")
-    f.check(required=("type",) + REQUIRED[kind], optional=("name",) + KEYS[kind])
-    name = f.get("name").as_name("a light name") if "name" in f else default_light_name(index)
-    w = node.where
     C = CLASSES[kind]
-    if kind == "point":
-        return C(name=name, position=read_vec3(f, C, "position"),
-                 intensity=read_color(f.get("intensity"), C, "intensity"), where=w)
+    extra = EXTRA_KEYS.get(kind, ())
+    f.check(required=("type",) + required_keys(C) + EXTRA_REQUIRED.get(kind, ()),
+            optional=yaml_keys(C) + extra)
+    name = f.get("name").as_name("a light name") if "name" in f else default_light_name(index)
+    common = dict(name=name, where=node.where, **read_fields(f, C))
     if kind == "directional":
-        d = read_vec3(f, C, "direction_to_light")
-        norm = math.sqrt(sum(x * x for x in d))
-        if not norm > 0:
+        if not math.sqrt(sum(x * x for x in common["direction_to_light"])) > 0:
             raise f.get("direction_to_light").error("expected a non-zero direction [x, y, z], got [0, 0, 0]")
-        return C(name=name, direction_to_light=d,
-                 irradiance=read_color(f.get("irradiance"), C, "irradiance"), where=w)
-    if kind == "constant":
-        return C(name=name, where=w, radiance=read_color(f.get("radiance"), C, "radiance"))
+        return C(**common)
     if kind == "envmap":
         path, written = f.get("path").as_path(ENVMAP_SUFFIXES, "environment image")
-        return C(name=name, path=path, path_as_written=written, scale=read_float(f, C, "scale"),
-                 rotation_z_deg=read_float(f, C, "rotation_z_deg"), where=w)
+        return C(path=path, path_as_written=written, **common)
     if kind == "spot":
-        cutoff = read_float(f, C, "cutoff_deg")
+        cutoff = common["cutoff_deg"]
         beam = read_float(f, C, "beam_width_deg", default=ml.BEAM_WIDTH_FRACTION * cutoff,
                           hi=cutoff)
-        pos, tgt = read_vec3(f, C, "position"), read_vec3(f, C, "target")
-        world_from_light = aim(pos, tgt, WORLD_UP, f.get("target"))
-        return C(name=name, position=pos, target=tgt, world_from_light=world_from_light,
-                 intensity=read_color(f.get("intensity"), C, "intensity"), cutoff_deg=cutoff,
-                 beam_width_deg=beam, where=w)
-    size = read_floats(f, C, "size", 2)
+        world_from_light = aim(common["position"], common["target"], WORLD_UP, f.get("target"))
+        return C(world_from_light=world_from_light, beam_width_deg=beam, **common)
+    if kind != "area":
+        return C(**common)
     which = f.one_of(("transform", "position"))
     if which == "transform":
         for bad in ("look_at", "up"):
@@ -79,5 +63,4 @@ def parse_light(node: Node, index: int, ctx: ParseContext) -> ml.Light:
             raise f.missing("look_at", " (an area light at 'position' faces 'look_at')")
         up = read_vec3(f, LookAt, "up")  # as for a look_at view
         world_from_light = aim(f.vec3("position"), f.vec3("look_at"), up, f.get("look_at"))
-    return C(name=name, size=size, world_from_light=world_from_light,
-             radiance=read_color(f.get("radiance"), C, "radiance"), where=w)
+    return C(world_from_light=world_from_light, **common)

@@ -1,0 +1,98 @@
+"""The generated part of the parser: every plain field of a spec dataclass (one YAML value under
+its own key, :attr:`scenegen.spec.model.meta.FieldInfo.plain`) is read from its metadata alone --
+key, reader (from the annotation, :func:`~scenegen.spec.model.meta.value_kind`), unit, range,
+choices and default -- so that adding such a field is one line in the model. The section parsers
+call these and keep only what spans fields (cross-field checks, derived values, ``type:``
+dispatch, names and references).
+"""
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+from scenegen.located_yaml import Fields, Node
+from scenegen.spec.model.meta import FieldInfo, spec_fields, value_count
+from scenegen.spec.parse.read import bounds, value_node
+
+
+def read_value(node: Node, fi: FieldInfo) -> Any:
+    """The value of ``node`` as field ``fi`` takes it (messages name the field's unit)."""
+    m, kind = fi.meta, fi.kind
+    if kind == "float":
+        return node.as_float(m.shown, **bounds(fi))
+    if kind == "int":
+        return node.as_int(m.shown, **bounds(fi, opens=False))
+    if kind == "bool":
+        return node.as_bool()
+    if kind == "enum":
+        return node.as_enum(m.choices, m.shown)
+    if kind == "str":
+        return node.as_str(m.shown or "a string")
+    if kind == "floats":
+        kw = bounds(fi)
+        kw.pop("hi_open", None)  # the list reader has no open upper bound
+        return node.as_floats(value_count(fi.owner, fi.name), m.shown, **kw)
+    if kind == "color":
+        color = node.as_color(m.shown)
+        if m.hi is not None and max(color) > m.hi:
+            raise node.error(f"expected {fi.name} in [{m.lo or 0:g}, {m.hi:g}] ({m.shown}), "
+                             f"got {color}")
+        return color
+    raise TypeError(f"{fi.owner.__name__}.{fi.name}: unknown value kind {kind!r}")
+
+
+def plain_fields(cls: type, skip: Iterable[str] = ()) -> list[FieldInfo]:
+    """The plain fields of ``cls`` (declaration order), less those named in ``skip``."""
+    skip = set(skip)
+    return [fi for fi in spec_fields(cls) if fi.plain and fi.name not in skip]
+
+
+def written_fields(cls: type, skip: Iterable[str] = ()) -> list[FieldInfo]:
+    """The fields of ``cls`` written as one value under their own key: the plain ones and those
+    derived when absent (declaration order), less those named in ``skip``."""
+    skip = set(skip)
+    return [fi for fi in spec_fields(cls) if not fi.meta.part and fi.name not in skip
+            and not any(c in fi.key for c in ".[ ")]
+
+
+def yaml_keys(cls: type, skip: Iterable[str] = ()) -> tuple[str, ...]:
+    """The YAML keys of the written fields of ``cls``."""
+    return tuple(fi.key for fi in written_fields(cls, skip))
+
+
+def required_keys(cls: type, skip: Iterable[str] = ()) -> tuple[str, ...]:
+    return tuple(fi.key for fi in written_fields(cls, skip) if fi.required)
+
+
+def read_field(f: Fields, fi: FieldInfo) -> Any:
+    """The field's value in ``f``, or its default when absent (None when required: the key
+    check has then already failed)."""
+    node = value_node(f, fi.key, fi)
+    if node is None:
+        return None if fi.required else fi.default
+    return read_value(node, fi)
+
+
+def read_fields(f: Fields, cls: type, skip: Iterable[str] = ()) -> dict[str, Any]:
+    """{field name: value or default} of every plain field of ``cls`` not in ``skip``."""
+    return {fi.name: read_field(f, fi) for fi in plain_fields(cls, skip)}
+
+
+def read_given(f: Fields, cls: type, skip: Iterable[str] = ()) -> dict[str, Any]:
+    """{field name: value} of the written fields present in ``f`` only, derived ones included
+    (overrides of a base such as an imaging preset)."""
+    return {fi.name: read_value(f.get(fi.key), fi) for fi in written_fields(cls, skip)
+            if fi.key in f}
+
+
+def record_mapping(node: Node, cls: type, noun: str, skip: Iterable[str] = ()) -> Fields:
+    """``node`` as the mapping of a record of ``cls``: '<noun> (key, key, ...)' expected, its
+    keys checked (required ones first)."""
+    keys = yaml_keys(cls, skip)
+    f = node.as_mapping(f"{noun} ({', '.join(keys)})")
+    required = required_keys(cls, skip)
+    return f.check(required=required, optional=[k for k in keys if k not in required])
+
+
+def parse_record(node: Node, cls: type, noun: str):
+    """A record of ``cls`` whose fields are all plain (e.g. a thin lens, a shutter)."""
+    return cls(**read_fields(record_mapping(node, cls, noun), cls))
