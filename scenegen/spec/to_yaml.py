@@ -26,7 +26,6 @@ from scenegen.spec.load import parse_spec
 from scenegen.spec.parse.fields import written_fields
 from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.optics import OPTICS_KEYS
-from scenegen.spec.parse.materials import TYPE_KEYS as MATERIAL_KEYS
 from scenegen.spec.serialize import spec_to_dict
 
 
@@ -89,10 +88,9 @@ def _maps(mp: m.SurfaceMaps) -> dict:
 
 def _material(mat) -> dict:
     d: dict[str, Any] = {"type": mat.type}
-    for key in MATERIAL_KEYS[mat.type]:
-        if key == "color" and mat.texture is not None or key == "texture" and mat.texture is None:
-            continue  # one of the two
-        d[key] = _texture(mat.texture) if key == "texture" else _v(getattr(mat, key))
+    if getattr(mat, "texture", None) is not None:
+        d["texture"] = _texture(mat.texture)
+    d.update(_record(mat))  # `color` is None (left out) when `texture` is given
     if mat.maps is not None:
         d.update(_maps(mat.maps))
     return d
@@ -220,9 +218,9 @@ def _rig(r: m.Rig) -> dict:
 
 def _placement(p, frame: str) -> tuple[str, Any]:
     if isinstance(p, m.Orbit):
-        return "orbit", _fields(p, ("center", "radius_m", "elevations_deg", "count", "start_azimuth_deg"))
+        return "orbit", _record(p)
     if isinstance(p, m.LookAtList):
-        return "look_at", [_fields(e, ("eye", "target", "up")) for e in p.entries]
+        return "look_at", [_record(e) for e in p.entries]
     if isinstance(p, m.PoseList):
         return "poses", [{f"world_from_{frame}": [[float(v) for v in row] for row in w.matrix]}
                          for w in p.world_from_cam]
@@ -256,11 +254,9 @@ def _view_set(vs: m.ViewSet) -> dict:
 
 def _crossview(c) -> dict:
     d: dict[str, Any] = {"pairs": c.pairs if isinstance(c.pairs, str) else [list(p) for p in c.pairs]}
-    d.update(flow=c.flow, stereo=c.stereo, sift=c.sift, sift_ratio=c.sift_ratio,
-             sift_inlier_px=c.sift_inlier_px, targets=c.targets)
+    d.update(_record(c, ("pairs",)))
     if c.matches is not None:
-        d["matches"] = _fields(c.matches, ("count", "sigma_px", "outlier_fraction", "near_miss_fraction",
-                                           "near_miss_px", "seed"))
+        d["matches"] = _record(c.matches)
     return d
 
 
@@ -316,7 +312,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     if spec.variation is not None:
         d["variation"] = _variation(spec.variation)
     if spec.truth is not None:
-        d["truth"] = {"albedo": spec.truth.albedo, "lights": spec.truth.lights, "defocus": spec.truth.defocus}
+        d["truth"] = _record(spec.truth)
     return d
 
 

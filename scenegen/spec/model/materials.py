@@ -28,7 +28,7 @@ _NAME = "key under `materials:`; None for an inline material"
 
 @dataclass(frozen=True, kw_only=True)
 class Texture:
-    kind: str = param(unit="texture type", choices=TEXTURE_KINDS)  # YAML `type`
+    kind: str = param(unit="texture type", choices=TEXTURE_KINDS, key="type")
     path: Path | None = part(None, unit="image file (absolute) for kind 'image'; None for "
                                          "procedural")
     path_as_written: str | None = part(None, unit="the path as in the spec (relative to the "
@@ -107,7 +107,7 @@ class DielectricMaterial:
     roughness: float = param(0.0, unit="GGX alpha", lo=0.0)  # 0 = smooth (dielectric); > 0 =
     # roughdielectric (frosted glass)
     transmittance: tuple[float, float, float] = param((1.0, 1.0, 1.0), unit="linear RGB", lo=0.0,
-                                                      hi=1.0)  # specular transmittance (tint)
+                                                      hi=1.0, kind="color")  # specular transmittance (tint)
     maps: SurfaceMaps | None = part(None, **_MAPS)
     where: Where | None = where_field()
     type: str = field(default="dielectric", init=False)
@@ -120,7 +120,7 @@ class ThinDielectricMaterial:
     name: str | None = part(None, unit=_NAME)
     ior: float = param(1.5, unit="index of refraction", lo=1.0, lo_open=True)
     transmittance: tuple[float, float, float] = param((1.0, 1.0, 1.0), unit="linear RGB", lo=0.0,
-                                                      hi=1.0)
+                                                      hi=1.0, kind="color")
     maps: SurfaceMaps | None = part(None, **_MAPS)
     where: Where | None = where_field()
     type: str = field(default="thin_dielectric", init=False)

@@ -8,11 +8,12 @@ from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model.crossview import CrossviewSpec, MatchSetSpec
 from scenegen.spec.model.views import View
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_bool, read_enum, read_float, read_floats, read_int, seed_or_none
+from scenegen.spec.model.meta import spec_fields
+from scenegen.spec.parse.fields import read_fields, yaml_keys
+from scenegen.spec.parse.read import read_enum, seed_or_none
 
-KEYS = ("pairs", "flow", "stereo", "matches", "sift", "sift_ratio", "sift_inlier_px", "targets")
-MATCH_KEYS = ("count", "sigma_px", "outlier_fraction", "near_miss_fraction", "near_miss_px",
-              "seed")
+KEYS = tuple(fi.key for fi in spec_fields(CrossviewSpec))
+MATCH_KEYS = yaml_keys(MatchSetSpec)
 #: (view name, its node) of every view an explicit pair names, to check against resolved views.
 NamedViews = tuple[tuple[str, Node], ...]
 
@@ -41,25 +42,19 @@ def parse_crossview(node: Node, ctx: ParseContext) -> tuple[CrossviewSpec, Named
     else:
         pairs = read_enum(f, C, "pairs")
     matches = parse_matches(f.get("matches"), ctx) if "matches" in f else None
-    spec = C(pairs=pairs, flow=read_bool(f, C, "flow"), stereo=read_bool(f, C, "stereo"),
-             matches=matches, sift=read_bool(f, C, "sift"),
-             sift_ratio=read_float(f, C, "sift_ratio"),
-             sift_inlier_px=read_float(f, C, "sift_inlier_px"),
-             targets=read_bool(f, C, "targets"), where=node.where)
+    spec = C(pairs=pairs, matches=matches, **read_fields(f, C, skip=("pairs",)), where=node.where)
     return spec, tuple(named)
 
 
 def parse_matches(node: Node, ctx: ParseContext) -> MatchSetSpec:
     mf = node.as_mapping("a match-set mapping (count, sigma_px, ...)").check(optional=MATCH_KEYS)
     M = MatchSetSpec
-    near = read_floats(mf, M, "near_miss_px", 2)
+    values = read_fields(mf, M)
+    near = values["near_miss_px"]
     if near[0] > near[1]:
         raise mf.get("near_miss_px").error(f"expected min <= max, got {list(near)}")
     seed = seed_or_none(mf, M)
-    return M(count=read_int(mf, M, "count"), sigma_px=read_float(mf, M, "sigma_px"),
-             outlier_fraction=read_float(mf, M, "outlier_fraction"),
-             near_miss_fraction=read_float(mf, M, "near_miss_fraction"), near_miss_px=near,
-             seed=ctx.seed_for(node.path) if seed is None else seed, where=node.where)
+    return M(**values, seed=ctx.seed_for(node.path) if seed is None else seed, where=node.where)
 
 
 def check_pair_views(named: NamedViews, views: Sequence[View]) -> None:

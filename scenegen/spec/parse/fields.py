@@ -84,13 +84,18 @@ def read_given(f: Fields, cls: type, skip: Iterable[str] = ()) -> dict[str, Any]
             if fi.key in f}
 
 
+def check_keys(f: Fields, cls: type, skip: Iterable[str] = ()) -> Fields:
+    """``f`` with its keys checked against the written fields of ``cls`` (the required ones
+    first, then the others in declaration order)."""
+    required = required_keys(cls, skip)
+    return f.check(required=required,
+                   optional=[k for k in yaml_keys(cls, skip) if k not in required])
+
+
 def record_mapping(node: Node, cls: type, noun: str, skip: Iterable[str] = ()) -> Fields:
     """``node`` as the mapping of a record of ``cls``: '<noun> (key, key, ...)' expected, its
-    keys checked (required ones first)."""
-    keys = yaml_keys(cls, skip)
-    f = node.as_mapping(f"{noun} ({', '.join(keys)})")
-    required = required_keys(cls, skip)
-    return f.check(required=required, optional=[k for k in keys if k not in required])
+    keys checked (:func:`check_keys`)."""
+    return check_keys(node.as_mapping(f"{noun} ({', '.join(yaml_keys(cls, skip))})"), cls, skip)
 
 
 def parse_record(node: Node, cls: type, noun: str):

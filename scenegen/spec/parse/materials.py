@@ -6,9 +6,10 @@ from __future__ import annotations
 from scenegen.assets.textures import check_texture_size, texture_params
 from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model import materials as mm
-from scenegen.spec.model.meta import field_info, frozen_mapping
+from scenegen.spec.model.meta import field_info, frozen_mapping, spec_fields
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_bool, read_color, read_enum, read_float, seed_or_none
+from scenegen.spec.parse.fields import read_fields, written_fields
+from scenegen.spec.parse.read import read_enum, seed_or_none
 
 
 def freeze(value):
@@ -48,20 +49,16 @@ def parse_texture(node: Node, ctx: ParseContext) -> mm.Texture:
     return mm.Texture(kind=kind, params=freeze(params), seed=seed, where=node.where)
 
 
-MAP_KEYS = ("normal_map", "bump_map", "bump_scale", "alpha", "alpha_cutoff", "alpha_blend")
-#: The keys of each material type besides `type` and the maps.
-TYPE_KEYS = {
-    "diffuse": ("color", "texture"),
-    "plastic": ("color", "texture", "roughness", "ior"),
-    "conductor": ("material", "roughness"),
-    "dielectric": ("ior", "roughness", "transmittance"),
-    "thin_dielectric": ("ior", "transmittance"),
-    "principled": ("color", "texture", "metallic", "roughness", "specular", "spec_trans",
-                   "clearcoat", "sheen"),
-}
+MAP_KEYS = tuple(fi.key for fi in spec_fields(mm.SurfaceMaps))
 CLASSES = {"diffuse": mm.DiffuseMaterial, "plastic": mm.PlasticMaterial,
            "conductor": mm.ConductorMaterial, "dielectric": mm.DielectricMaterial,
            "thin_dielectric": mm.ThinDielectricMaterial, "principled": mm.PrincipledMaterial}
+
+#: The keys of each material type besides `type` and the maps: its written fields (and
+#: `texture`, the alternative to `color`), generated from the dataclasses.
+TYPE_KEYS = {kind: tuple(fi.key for fi in spec_fields(cls)
+                         if fi.name == "texture" or fi in written_fields(cls))
+             for kind, cls in CLASSES.items()}
 
 
 def parse_map(node: Node, ctx: ParseContext) -> mm.Texture:
@@ -82,10 +79,8 @@ def parse_maps(f, node: Node, ctx: ParseContext) -> mm.SurfaceMaps | None:
         if k in f and owner not in f:
             raise f.get(k).error(f"{k!r} goes with {owner!r}, which is missing")
     get = lambda k: parse_map(f.get(k), ctx) if k in f else None
-    return S(normal_map=get("normal_map"), bump_map=get("bump_map"),
-             bump_scale=read_float(f, S, "bump_scale"), alpha=get("alpha"),
-             alpha_cutoff=read_float(f, S, "alpha_cutoff"),
-             alpha_blend=read_bool(f, S, "alpha_blend"), where=node.where)
+    return S(normal_map=get("normal_map"), bump_map=get("bump_map"), alpha=get("alpha"),
+             **read_fields(f, S), where=node.where)
 
 
 def _color_or_texture(f, cls, ctx: ParseContext):
@@ -108,7 +103,8 @@ def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Materi
     kind = f.get("type").as_enum(mm.MATERIAL_TYPES, "material type")
     f.check(required=("type",), optional=TYPE_KEYS[kind] + MAP_KEYS)
     cls = CLASSES[kind]
-    common = {"name": name, "maps": parse_maps(f, node, ctx), "where": node.where}
+    common = {"name": name, "maps": parse_maps(f, node, ctx), "where": node.where,
+              **read_fields(f, cls, skip=("color", "material"))}
     if kind == "conductor":
         cname = field_info(cls, "material").default
         if "material" in f:
@@ -117,21 +113,8 @@ def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Materi
                 raise f.get("material").error(
                     f"unknown conductor {cname!r}{suggest(cname, mm.CONDUCTOR_NAMES)}; "
                     "Mitsuba knows e.g. 'Al', 'Ag', 'Au', 'Cu', 'Cr', 'W'")
-        return cls(material=cname, roughness=read_float(f, cls, "roughness"), **common)
-    if kind in ("dielectric", "thin_dielectric"):
-        extra = {"roughness": read_float(f, cls, "roughness")} if kind == "dielectric" else {}
-        trans = field_info(cls, "transmittance").default
-        if "transmittance" in f:
-            trans = read_color(f.get("transmittance"), cls, "transmittance")
-            if max(trans) > 1.0:
-                raise f.get("transmittance").error(f"expected transmittance in [0, 1] (linear "
-                                                   f"RGB), got {trans}")
-        return cls(ior=read_float(f, cls, "ior"), transmittance=trans, **extra, **common)
+        return cls(material=cname, **common)
+    if "color" not in TYPE_KEYS[kind]:
+        return cls(**common)
     color, texture = _color_or_texture(f, cls, ctx)
-    if kind == "diffuse":
-        return cls(color=color, texture=texture, **common)
-    if kind == "plastic":
-        return cls(color=color, texture=texture, roughness=read_float(f, cls, "roughness"),
-                   ior=read_float(f, cls, "ior"), **common)
-    return cls(color=color, texture=texture,
-               **{k: read_float(f, cls, k) for k in TYPE_KEYS["principled"][2:]}, **common)
+    return cls(color=color, texture=texture, **common)

@@ -2,21 +2,20 @@
 from __future__ import annotations
 
 from scenegen.located_yaml import Node
-from scenegen.spec.model.meta import spec_fields
 from scenegen.spec.model.truth import TruthSpec
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_bool
+from scenegen.spec.parse.fields import read_fields, yaml_keys
 
-KEYS = tuple(fi.name for fi in spec_fields(TruthSpec))
+KEYS = yaml_keys(TruthSpec)
 
 
 def parse_truth(node: Node, ctx: ParseContext) -> TruthSpec:
     f = node.as_mapping(f"a truth section ({', '.join(KEYS)}: true or false)").check(optional=KEYS)
-    if ctx.sequence is not None and read_bool(f, TruthSpec, "albedo"):
+    values = read_fields(f, TruthSpec)
+    if ctx.sequence is not None and values["albedo"]:
         raise f.get("albedo").error("albedo truth is for static scenes; this spec has a `sequence:`")
-    defocus = read_bool(f, TruthSpec, "defocus")
-    if defocus and not any(getattr(c.optics, "lens", None) is not None for c in ctx.cameras.values()):
+    if values["defocus"] and not any(getattr(c.optics, "lens", None) is not None
+                                     for c in ctx.cameras.values()):
         ctx.warn(f.get("defocus") or node, "defocus truth is written for cameras with a thin lens (`lens:`); "
                  "no camera has one, so no view gets it")
-    return TruthSpec(albedo=read_bool(f, TruthSpec, "albedo"), lights=read_bool(f, TruthSpec, "lights"),
-                     defocus=defocus, where=node.where)
+    return TruthSpec(**values, where=node.where)

@@ -8,8 +8,9 @@ from scenegen.spec.model import views as mv
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.optics import parse_motion
-from scenegen.spec.parse.read import read_float, read_floats, read_int, read_vec3, seed_or_none
+from scenegen.spec.parse.read import read_float, read_int, read_vec3, seed_or_none
 from scenegen.spec.parse.timeline import parse_trajectory
 from scenegen.spec.parse.transforms import parse_pose
 
@@ -95,30 +96,24 @@ def parse_trajectory_path(node: Node, frame: str, ctx: ParseContext) -> mv.Traje
 
 
 def parse_orbit(node: Node, frame: str, ctx: ParseContext) -> mv.Orbit:
-    f = node.as_mapping("an orbit (center, radius_m, elevations_deg, count)").check(
-        required=("radius_m", "count"),
-        optional=("center", "elevations_deg", "start_azimuth_deg"))
     O = mv.Orbit
-    elevations = read_floats(f, O, "elevations_deg", None)
+    f = check_keys(node.as_mapping("an orbit (center, radius_m, elevations_deg, count)"), O)
+    values = read_fields(f, O)
     if "elevations_deg" in f:
         hi = field_info(O, "elevations_deg").meta.hi
-        for item, e in zip(f.get("elevations_deg").items(), elevations):
+        for item, e in zip(f.get("elevations_deg").items(), values["elevations_deg"]):
             if abs(e) >= hi:
                 raise item.error(f"expected an elevation strictly between -90 and 90 degrees "
                                  f"(the view would be parallel to up), got {e:g}")
-    return O(center=read_vec3(f, O, "center"), radius_m=read_float(f, O, "radius_m"),
-             elevations_deg=elevations, count=read_int(f, O, "count"),
-             start_azimuth_deg=read_float(f, O, "start_azimuth_deg"))
+    return O(**values)
 
 
 def parse_look_at_list(node: Node, frame: str, ctx: ParseContext) -> mv.LookAtList:
     entries = []
     L = mv.LookAt
     for item in node.items("a list of {eye, target, up} mappings"):
-        f = item.as_mapping("a mapping with eye, target and optionally up").check(
-            required=("eye", "target"), optional=("up",))
-        entry = L(eye=read_vec3(f, L, "eye"), target=read_vec3(f, L, "target"),
-                  up=read_vec3(f, L, "up"))
+        f = check_keys(item.as_mapping("a mapping with eye, target and optionally up"), L)
+        entry = L(**read_fields(f, L))
         try:
             look_at(entry.eye, entry.target, entry.up)
         except ValueError as e:
