@@ -56,9 +56,11 @@ def _fields(obj, names) -> dict:
 def _record(obj, skip=()) -> dict:
     """The written fields of a spec record under their YAML keys (generated from the field
     metadata, :func:`scenegen.spec.parse.fields.written_fields`); None values left out (absent
-    means None or the value derived from the others)."""
+    means None or the value derived from the others), as are ``omit_default`` fields at their
+    default (as in the resolved spec)."""
     return {fi.key: _v(getattr(obj, fi.name)) for fi in written_fields(type(obj), skip)
-            if getattr(obj, fi.name) is not None}
+            if getattr(obj, fi.name) is not None
+            and not (fi.meta.omit_default and getattr(obj, fi.name) == fi.default)}
 
 
 def _texture(t: m.Texture) -> dict:
@@ -189,13 +191,7 @@ def _imaging(p: ImagingParams) -> dict:
 
 def _camera(c: m.CameraSpec) -> dict:
     d: dict[str, Any] = {"model": c.model, "size": [c.width, c.height]}
-    if c.fov_deg is not None:
-        d["fov_deg"] = c.fov_deg
-    else:
-        d.update(fx=c.fx, fy=c.fy)
-    d.update(cx=c.cx, cy=c.cy, skew=c.skew, dist=_v(c.dist))
-    if c.mask_beyond_fold:
-        d["mask_beyond_fold"] = True
+    d.update(_record(c, ("fx", "fy") if c.fov_deg is not None else ()))  # fx, fy: from fov_deg
     o = c.optics
     if o is not None:
         for key in OPTICS_KEYS:
@@ -265,25 +261,20 @@ def _variation(v) -> dict:
     if v.objects:
         d["objects"] = {}
         for o in v.objects:
-            e: dict[str, Any] = {"reseed": o.reseed}
+            e = _record(o)  # yaw_deg, reseed; the boxes below
             if o.position_min is not None:
                 e["position"] = {"min": _v(o.position_min), "max": _v(o.position_max)}
-            if o.yaw_deg is not None:
-                e["yaw_deg"] = _v(o.yaw_deg)
             if o.color_min is not None:
                 e["color"] = {"min": _v(o.color_min), "max": _v(o.color_max)}
             d["objects"][o.object] = e
     if v.lights:
-        d["lights"] = {li.light: {"position_jitter_m": li.position_jitter_m,
-                                  **({"intensity_scale": _v(li.intensity_scale)} if li.intensity_scale else {})}
-                       for li in v.lights}
+        d["lights"] = {li.light: _record(li) for li in v.lights}
     if v.cameras:
-        d["cameras"] = {c.camera: {"principal_point_px": c.principal_point_px,
-                                   **({"focal_scale": _v(c.focal_scale)} if c.focal_scale else {}),
+        d["cameras"] = {c.camera: {**_record(c, ("dist_jitter",)),
                                    **({"dist_jitter": _v(c.dist_jitter)} if c.dist_jitter else {})}
                         for c in v.cameras}
     if v.views is not None:
-        d["views"] = _fields(v.views, ("translation_m", "rotation_deg"))
+        d["views"] = _record(v.views)
     return d
 
 

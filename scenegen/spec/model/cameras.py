@@ -29,8 +29,8 @@ class CameraSpec:
 
     name: str  # key under `cameras:`
     model: str = param("pinhole", unit="camera model", choices=MODEL_NAMES)
-    width: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX)  # YAML `size: [W, H]`, whole pixels
-    height: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX)
+    width: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX, key="size[0]")  # whole pixels
+    height: int = param(unit="pixels", lo=1, hi=MAX_IMAGE_SIDE_PX, key="size[1]")
     fx: float = param(unit=_PX, lo=0.0, lo_open=True, derived="from fov_deg")  # focal length
     # along u
     fy: float = param(unit=_PX, lo=0.0, lo_open=True, derived="fx")  # focal length along v

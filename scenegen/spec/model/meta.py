@@ -62,7 +62,8 @@ class Meta:
     key: str | None = None  # the YAML key where it differs from the field name; one with '.',
     # '[' or ' ' is a path into a value the section's own code reads (e.g. 'size[0]')
     kind: str | None = None  # how the value is read where the type does not say it: 'color'
-    # (a grey number or 3 numbers), 'str'; else from the annotation (see value_kind)
+    # (a grey number or 3 numbers), 'range' ([min, max], min <= max), 'str'; else from the
+    # annotation (see value_kind)
     count: Any = None  # allowed lengths of a list (an int, a tuple of ints, or None: any)
     # where the tuple annotation does not fix it
 

@@ -17,13 +17,15 @@ _M = "metres"
 @dataclass(frozen=True, kw_only=True)
 class ObjectVariation:
     object: str  # name of an object in `objects:`
-    position_min: tuple[float, float, float] | None = param(None, unit=_M)  # box of the object
-    position_max: tuple[float, float, float] | None = param(None, unit=_M)  # origin, world
-    # (replaces its translation); YAML position: {min, max}
-    yaw_deg: tuple[float, float] | None = param(None, unit="degrees")  # range of the turn about
-    # world +z through the origin
-    color_min: tuple[float, float, float] | None = param(None, unit="linear RGB", lo=0.0, hi=1.0)
-    color_max: tuple[float, float, float] | None = param(None, unit="linear RGB", lo=0.0, hi=1.0)
+    position_min: tuple[float, float, float] | None = param(None, unit=_M, key="position.min")
+    # box of the object origin, world (replaces its translation)
+    position_max: tuple[float, float, float] | None = param(None, unit=_M, key="position.max")
+    yaw_deg: tuple[float, float] | None = param(None, unit="degrees", kind="range")  # range of
+    # the turn about world +z through the origin
+    color_min: tuple[float, float, float] | None = param(None, unit="linear RGB", lo=0.0, hi=1.0,
+                                                         key="color.min")
+    color_max: tuple[float, float, float] | None = param(None, unit="linear RGB", lo=0.0, hi=1.0,
+                                                         key="color.max")
     # box of the material colour (diffuse/plastic with a colour only); YAML color: {min, max}
     reseed: bool = param(False, unit="flag")  # redraw the seeds of its procedural texture and
     # blob shape
@@ -33,7 +35,7 @@ class ObjectVariation:
 @dataclass(frozen=True, kw_only=True)
 class LightVariation:
     light: str  # name of a light in `lights:`
-    intensity_scale: tuple[float, float] | None = param(None, unit="factor", lo=0.0)  # range of
+    intensity_scale: tuple[float, float] | None = param(None, unit="factor", lo=0.0, kind="range")  # range of
     # the factor on radiance/intensity/scale
     position_jitter_m: float = param(0.0, unit=_M, lo=0.0)  # uniform offset in [-j, j] per world
     # axis (area/point/spot)
@@ -43,7 +45,8 @@ class LightVariation:
 @dataclass(frozen=True, kw_only=True)
 class CameraVariation:
     camera: str  # name of a camera in `cameras:`
-    focal_scale: tuple[float, float] | None = param(None, unit="factor", lo=0.0, lo_open=True)
+    focal_scale: tuple[float, float] | None = param(None, unit="factor", lo=0.0, lo_open=True,
+                                                    kind="range")
     # range of one factor on fx and fy
     principal_point_px: float = param(0.0, unit="pixels", lo=0.0)  # uniform offset in [-j, j] on
     # cx and on cy

@@ -14,10 +14,12 @@ from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.imaging import parse_imaging
 from scenegen.spec.parse.optics import OPTICS_KEYS, parse_optics
-from scenegen.spec.parse.read import read_bool, read_enum, read_float
+from scenegen.spec.parse.fields import read_fields, yaml_keys
+from scenegen.spec.parse.read import read_float
 
-KEYS = ("model", "fx", "fy", "cx", "cy", "skew", "fov_deg", "dist", "mask_beyond_fold",
-        "imaging") + OPTICS_KEYS
+#: The written fields' keys (size, the focal lengths, principal point and dist read by hand:
+#: they depend on each other and on the model) and the camera's nested sections.
+KEYS = yaml_keys(CameraSpec) + ("imaging",) + OPTICS_KEYS
 
 
 def coefficient_order(cm: CameraModel) -> str:
@@ -34,7 +36,8 @@ def parse_camera(node: Node, name: str, ctx: ParseContext) -> CameraSpec:
     f = node.as_mapping("a camera (a mapping with model, size and fx, fy or fov_deg)")
     f.check(required=("size",), optional=KEYS)
     C = CameraSpec
-    model = read_enum(f, C, "model")
+    values = read_fields(f, C)  # model, skew, mask_beyond_fold, fov_deg
+    model = values["model"]
     cm = MODELS[model]
     size_node = f.get("size")
     size = size_node.as_floats(2, "width, height in pixels")
@@ -53,22 +56,18 @@ def parse_camera(node: Node, name: str, ctx: ParseContext) -> CameraSpec:
         for bad in ("fx", "fy"):
             if bad in f:
                 raise f.get(bad).error("give either fov_deg or fx and fy, not both")
-        fov = read_float(f, C, "fov_deg")
         # As scenegen.geometry.camera.Camera.from_fov: the FoV of the undistorted pinhole.
-        fx = fy = (W / 2) / math.tan(math.radians(fov) / 2)
+        fx = fy = (W / 2) / math.tan(math.radians(values["fov_deg"]) / 2)
     else:
         if "fx" not in f:
             raise f.missing("fx", " (or give fov_deg)")
         fx = read_float(f, C, "fx", default=None)
         fy = read_float(f, C, "fy", default=fx)
-        fov = read_float(f, C, "fov_deg")  # absent
     cx = read_float(f, C, "cx", default=(W - 1) / 2)
     cy = read_float(f, C, "cy", default=(H - 1) / 2)
-    skew = read_float(f, C, "skew")
     dist = parse_dist(f.get("dist"), model, cm)
-    cam = C(name=name, model=model, width=W, height=H, fx=fx, fy=fy, cx=cx, cy=cy, skew=skew,
-            dist=dist, fov_deg=fov, where=node.where,
-            mask_beyond_fold=read_bool(f, C, "mask_beyond_fold"),
+    cam = C(name=name, **values, width=W, height=H, fx=fx, fy=fy, cx=cx,
+            cy=cy, dist=dist, where=node.where,
             imaging=parse_imaging(f.get("imaging"), name, ctx) if "imaging" in f else None,
             optics=parse_optics(f, model))
     if not (-0.5 <= cx <= W - 0.5 and -0.5 <= cy <= H - 0.5):

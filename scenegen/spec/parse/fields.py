@@ -31,6 +31,11 @@ def read_value(node: Node, fi: FieldInfo) -> Any:
         kw = bounds(fi)
         kw.pop("hi_open", None)  # the list reader has no open upper bound
         return node.as_floats(value_count(fi.owner, fi.name), m.shown, **kw)
+    if kind == "range":
+        a, b = node.as_floats(2, f"min and max, {m.unit}", lo=m.lo, lo_open=m.lo_open)
+        if a > b:
+            raise node.error(f"expected min <= max, got [{a:g}, {b:g}]")
+        return (a, b)
     if kind == "color":
         color = node.as_color(m.shown)
         if m.hi is not None and max(color) > m.hi:

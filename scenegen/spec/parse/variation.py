@@ -9,19 +9,11 @@ from scenegen.spec.model.lights import AreaLight, PointLight, SpotLight
 from scenegen.spec.model.materials import PROCEDURAL_TEXTURE_KINDS, DiffuseMaterial, PlasticMaterial
 from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.read import read_bool, read_float, seed_or_none
+from scenegen.spec.parse.fields import read_fields, record_mapping
+from scenegen.spec.parse.read import seed_or_none
 
 #: Field path the variation seed is derived from (with the scene seed).
 SEED_PATH = "variation"
-
-
-def parse_range(node: Node, cls: type, name: str) -> tuple[float, float]:
-    """[min, max] with min <= max, each in the field's range."""
-    meta = field_info(cls, name).meta
-    a, b = node.as_floats(2, f"min and max, {meta.unit}", lo=meta.lo, lo_open=meta.lo_open)
-    if a > b:
-        raise node.error(f"expected min <= max, got [{a:g}, {b:g}]")
-    return (a, b)
 
 
 def parse_box(node: Node, cls: type, name: str):
@@ -65,11 +57,8 @@ def parse_variation(node: Node, ctx: ParseContext) -> mv.VariationSpec:
                                           "camera")] if "cameras" in f else []
     views = None
     if "views" in f:
-        P = mv.PoseJitter
-        vf = f.get("views").as_mapping("a pose jitter (translation_m, rotation_deg)")
-        vf.check(optional=("translation_m", "rotation_deg"))
-        views = P(translation_m=read_float(vf, P, "translation_m"),
-                  rotation_deg=read_float(vf, P, "rotation_deg"), where=f.get("views").where)
+        vf = record_mapping(f.get("views"), mv.PoseJitter, "a pose jitter")
+        views = mv.PoseJitter(**read_fields(vf, mv.PoseJitter), where=f.get("views").where)
     return mv.VariationSpec(seed=seed, objects=tuple(objs), lights=tuple(lts),
                             cameras=tuple(cams), views=views, where=node.where)
 
@@ -98,36 +87,31 @@ def parse_object_variation(name: str, vn: Node, ctx: ParseContext) -> mv.ObjectV
                 f"{' with a texture' if getattr(mat, 'texture', None) else ''}; colour variation "
                 "needs a diffuse or plastic material with a colour")
         col = parse_box(of.get("color"), O, "color_min")
-    reseed = read_bool(of, O, "reseed")
-    if reseed:
+    values = read_fields(of, O)  # yaw_deg, reseed
+    if values["reseed"]:
         tex = getattr(obj.material, "texture", None)
         procedural = tex is not None and tex.kind in PROCEDURAL_TEXTURE_KINDS
         if not procedural and not isinstance(obj.geometry, Blob):
             raise of.get("reseed").error(f"object {name!r} has neither a procedural texture nor "
                                          "a blob shape: nothing to reseed")
-    return O(object=name, position_min=pos[0], position_max=pos[1],
-             yaw_deg=parse_range(of.get("yaw_deg"), O, "yaw_deg") if "yaw_deg" in of else None,
-             color_min=col[0], color_max=col[1], reseed=reseed, where=vn.where)
+    return O(object=name, position_min=pos[0], position_max=pos[1], color_min=col[0],
+             color_max=col[1], **values, where=vn.where)
 
 
 def parse_light_variation(name: str, vn: Node, ctx: ParseContext) -> mv.LightVariation:
     L = mv.LightVariation
-    lf = vn.as_mapping("a light variation (intensity_scale, position_jitter_m)")
-    lf.check(optional=("intensity_scale", "position_jitter_m"))
-    jitter = read_float(lf, L, "position_jitter_m")
+    lf = record_mapping(vn, L, "a light variation")
+    values = read_fields(lf, L)
     light = next(li for li in ctx.lights if li.name == name)
-    if jitter > 0 and not isinstance(light, (AreaLight, PointLight, SpotLight)):
+    if values["position_jitter_m"] > 0 and not isinstance(light, (AreaLight, PointLight, SpotLight)):
         raise lf.get("position_jitter_m").error(
             f"light {name!r} is a {light.type} light, which has no position")
-    scale = (parse_range(lf.get("intensity_scale"), L, "intensity_scale")
-             if "intensity_scale" in lf else None)
-    return L(light=name, intensity_scale=scale, position_jitter_m=jitter, where=vn.where)
+    return L(light=name, **values, where=vn.where)
 
 
 def parse_camera_variation(name: str, vn: Node, ctx: ParseContext) -> mv.CameraVariation:
     C = mv.CameraVariation
-    cf = vn.as_mapping("a camera variation (focal_scale, principal_point_px, dist_jitter)")
-    cf.check(optional=("focal_scale", "principal_point_px", "dist_jitter"))
+    cf = record_mapping(vn, C, "a camera variation")
     cam = ctx.cameras[name]
     dist = field_info(C, "dist_jitter").default
     if "dist_jitter" in cf:
@@ -138,8 +122,5 @@ def parse_camera_variation(name: str, vn: Node, ctx: ParseContext) -> mv.CameraV
         meta = field_info(C, "dist_jitter").meta
         dist = cf.get("dist_jitter").as_floats(
             n, f"one half-width per coefficient of {name!r}'s dist", lo=meta.lo)
-    return C(camera=name,
-             focal_scale=(parse_range(cf.get("focal_scale"), C, "focal_scale")
-                          if "focal_scale" in cf else None),
-             principal_point_px=read_float(cf, C, "principal_point_px"),
-             dist_jitter=dist, where=vn.where)
+    return C(camera=name, **read_fields(cf, C, skip=("dist_jitter",)), dist_jitter=dist,
+             where=vn.where)
