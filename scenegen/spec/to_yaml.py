@@ -23,7 +23,7 @@ from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.imaging import ImagingParams
 from scenegen.spec import model as m
 from scenegen.spec.load import parse_spec
-from scenegen.spec.parse.fields import written_fields
+from scenegen.spec.parse.fields import plain_value, write_fields
 from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.optics import OPTICS_KEYS
 from scenegen.spec.serialize import spec_to_dict
@@ -32,13 +32,7 @@ from scenegen.spec.serialize import spec_to_dict
 __all__ = ["PYTHON_FILE", "check_spec", "same_spec", "spec_to_yaml_dict", "to_yaml"]
 
 
-def _v(x):
-    """Tuples as lists, floats as floats (numpy scalars too)."""
-    if isinstance(x, (tuple, list)):
-        return [_v(e) for e in x]
-    if hasattr(x, "tolist"):
-        return x.tolist()
-    return x
+_v = plain_value  # tuples as lists, numpy scalars as Python numbers
 
 
 def _matrix(pose) -> dict:
@@ -51,16 +45,6 @@ def _matrix(pose) -> dict:
 
 def _fields(obj, names) -> dict:
     return {n: _v(getattr(obj, n)) for n in names}
-
-
-def _record(obj, skip=()) -> dict:
-    """The written fields of a spec record under their YAML keys (generated from the field
-    metadata, :func:`scenegen.spec.parse.fields.written_fields`); None values left out (absent
-    means None or the value derived from the others), as are ``omit_default`` fields at their
-    default (as in the resolved spec)."""
-    return {fi.key: _v(getattr(obj, fi.name)) for fi in written_fields(type(obj), skip)
-            if getattr(obj, fi.name) is not None
-            and not (fi.meta.omit_default and getattr(obj, fi.name) == fi.default)}
 
 
 def _texture(t: m.Texture) -> dict:
@@ -92,7 +76,7 @@ def _material(mat) -> dict:
     d: dict[str, Any] = {"type": mat.type}
     if getattr(mat, "texture", None) is not None:
         d["texture"] = _texture(mat.texture)
-    d.update(_record(mat))  # `color` is None (left out) when `texture` is given
+    d.update(write_fields(mat))  # `color` is None (left out) when `texture` is given
     if mat.maps is not None:
         d.update(_maps(mat.maps))
     return d
@@ -122,7 +106,7 @@ def _object(obj: m.SceneObject, materials) -> dict:
         d["material"] = mat.name if named else _material(mat)
     d["instance_id"] = obj.instance_id
     if obj.motion is not None:
-        d["motion"] = _record(obj.motion)
+        d["motion"] = write_fields(obj.motion)
     if obj.animation is not None:
         d.update(_animation(obj.animation, _v(obj.transform.scale)))
         if obj.animation.trajectory is not None:  # the keyframes place it; `transform` scales only
@@ -171,7 +155,7 @@ def _sequence(q: m.SequenceSpec) -> dict:
 
 def _light(li) -> dict:
     d: dict[str, Any] = {"name": li.name, "type": li.type} if li.name is not None else {"type": li.type}
-    d.update(_record(li, ("name",)))
+    d.update(write_fields(li, ("name",)))
     if isinstance(li, m.EnvmapLight):
         d["path"] = li.path_as_written or str(li.path)
     elif isinstance(li, m.AreaLight):
@@ -181,22 +165,22 @@ def _light(li) -> dict:
 
 def _imaging(p: ImagingParams) -> dict:
     d: dict[str, Any] = {"preset": p.preset} if p.preset is not None else {}
-    d.update({block: _record(getattr(p, block)) for block in BLOCKS})
-    d.update(_record(p, ("preset",)))
+    d.update({block: write_fields(getattr(p, block)) for block in BLOCKS})
+    d.update(write_fields(p, ("preset",)))
     d["bayer"] = p.bayer if p.bayer is not None else "none"
     d["white_balance"] = _v(p.white_balance) if p.white_balance is not None else "auto"
-    d["raw"] = False if p.raw is None else _record(p.raw)
+    d["raw"] = False if p.raw is None else write_fields(p.raw)
     return d
 
 
 def _camera(c: m.CameraSpec) -> dict:
     d: dict[str, Any] = {"model": c.model, "size": [c.width, c.height]}
-    d.update(_record(c, ("fx", "fy") if c.fov_deg is not None else ()))  # fx, fy: from fov_deg
+    d.update(write_fields(c, ("fx", "fy") if c.fov_deg is not None else ()))  # fx, fy: from fov_deg
     o = c.optics
     if o is not None:
         for key in OPTICS_KEYS:
             if getattr(o, key) is not None:
-                d[key] = _record(getattr(o, key))
+                d[key] = write_fields(getattr(o, key))
     if c.imaging is not None:
         d["imaging"] = _imaging(c.imaging)
     return d
@@ -214,9 +198,9 @@ def _rig(r: m.Rig) -> dict:
 
 def _placement(p, frame: str) -> tuple[str, Any]:
     if isinstance(p, m.Orbit):
-        return "orbit", _record(p)
+        return "orbit", write_fields(p)
     if isinstance(p, m.LookAtList):
-        return "look_at", [_record(e) for e in p.entries]
+        return "look_at", [write_fields(e) for e in p.entries]
     if isinstance(p, m.PoseList):
         return "poses", [{f"world_from_{frame}": [[float(v) for v in row] for row in w.matrix]}
                          for w in p.world_from_cam]
@@ -242,7 +226,7 @@ def _view_set(vs: m.ViewSet) -> dict:
     key, val = _placement(vs.placement, "rig" if vs.rig else "cam")
     d[key] = val
     if vs.motion is not None:
-        d["motion"] = _record(vs.motion)
+        d["motion"] = write_fields(vs.motion)
     if vs.lights is not None:
         d["lights"] = {k: float(v) for k, v in vs.lights.items()}
     return d
@@ -250,9 +234,9 @@ def _view_set(vs: m.ViewSet) -> dict:
 
 def _crossview(c) -> dict:
     d: dict[str, Any] = {"pairs": c.pairs if isinstance(c.pairs, str) else [list(p) for p in c.pairs]}
-    d.update(_record(c, ("pairs",)))
+    d.update(write_fields(c, ("pairs",)))
     if c.matches is not None:
-        d["matches"] = _record(c.matches)
+        d["matches"] = write_fields(c.matches)
     return d
 
 
@@ -261,20 +245,20 @@ def _variation(v) -> dict:
     if v.objects:
         d["objects"] = {}
         for o in v.objects:
-            e = _record(o)  # yaw_deg, reseed; the boxes below
+            e = write_fields(o)  # yaw_deg, reseed; the boxes below
             if o.position_min is not None:
                 e["position"] = {"min": _v(o.position_min), "max": _v(o.position_max)}
             if o.color_min is not None:
                 e["color"] = {"min": _v(o.color_min), "max": _v(o.color_max)}
             d["objects"][o.object] = e
     if v.lights:
-        d["lights"] = {li.light: _record(li) for li in v.lights}
+        d["lights"] = {li.light: write_fields(li) for li in v.lights}
     if v.cameras:
-        d["cameras"] = {c.camera: {**_record(c, ("dist_jitter",)),
+        d["cameras"] = {c.camera: {**write_fields(c, ("dist_jitter",)),
                                    **({"dist_jitter": _v(c.dist_jitter)} if c.dist_jitter else {})}
                         for c in v.cameras}
     if v.views is not None:
-        d["views"] = _record(v.views)
+        d["views"] = write_fields(v.views)
     return d
 
 
@@ -283,7 +267,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     if spec.variant is not None:
         raise ValueError("a derived variant has no YAML of its own; write the spec it came from")
     d: dict[str, Any] = {"name": spec.name, "description": spec.description, "seed": spec.seed,
-                         "render": _record(spec.render)}
+                         "render": write_fields(spec.render)}
     if spec.sequence is not None:
         d["sequence"] = _sequence(spec.sequence)
     if spec.materials:
@@ -303,7 +287,7 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     if spec.variation is not None:
         d["variation"] = _variation(spec.variation)
     if spec.truth is not None:
-        d["truth"] = _record(spec.truth)
+        d["truth"] = write_fields(spec.truth)
     return d
 
 

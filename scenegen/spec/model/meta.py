@@ -155,11 +155,15 @@ class FieldInfo:
         return self.meta.key or self.name
 
     @property
+    def written(self) -> bool:
+        """One YAML value under its own key (not a part, not a path into a nested value such as
+        'size[0]'): written back by the generated code (scenegen.spec.parse.fields)."""
+        return not self.meta.part and not any(c in self.key for c in ".[ ")
+
+    @property
     def plain(self) -> bool:
-        """One YAML value under its own key, read and written by the generated code (not a part,
-        not derived from other values, not a path into a nested value)."""
-        return (not self.meta.part and self.meta.derived is None
-                and not any(c in self.key for c in ".[ "))
+        """Written and not derived from other values: also read by the generated code."""
+        return self.written and self.meta.derived is None
 
     @property
     def kind(self) -> str:

@@ -1,9 +1,10 @@
-"""The generated part of the parser: every plain field of a spec dataclass (one YAML value under
-its own key, :attr:`scenegen.spec.model.meta.FieldInfo.plain`) is read from its metadata alone --
-key, reader (from the annotation, :func:`~scenegen.spec.model.meta.value_kind`), unit, range,
-choices and default -- so that adding such a field is one line in the model. The section parsers
-call these and keep only what spans fields (cross-field checks, derived values, ``type:``
-dispatch, names and references).
+"""The generated part of the parser and of its inverse (``to_yaml``): every plain field of a
+spec dataclass (one YAML value under its own key, :attr:`scenegen.spec.model.meta.FieldInfo.plain`)
+is read from its metadata alone -- key, reader (from the annotation,
+:func:`~scenegen.spec.model.meta.value_kind`), unit, range, choices and default -- so that adding
+such a field is one line in the model. The section parsers call these and keep only what spans
+fields (cross-field checks, derived values, ``type:`` dispatch, names and references).
+:func:`write_fields` is the inverse of :func:`read_fields` for :mod:`scenegen.spec.to_yaml`.
 """
 from __future__ import annotations
 
@@ -55,8 +56,7 @@ def written_fields(cls: type, skip: Iterable[str] = ()) -> list[FieldInfo]:
     """The fields of ``cls`` written as one value under their own key: the plain ones and those
     derived when absent (declaration order), less those named in ``skip``."""
     skip = set(skip)
-    return [fi for fi in spec_fields(cls) if not fi.meta.part and fi.name not in skip
-            and not any(c in fi.key for c in ".[ ")]
+    return [fi for fi in spec_fields(cls) if fi.written and fi.name not in skip]
 
 
 def yaml_keys(cls: type, skip: Iterable[str] = ()) -> tuple[str, ...]:
@@ -106,3 +106,26 @@ def record_mapping(node: Node, cls: type, noun: str, skip: Iterable[str] = ()) -
 def parse_record(node: Node, cls: type, noun: str):
     """A record of ``cls`` whose fields are all plain (e.g. a thin lens, a shutter)."""
     return cls(**read_fields(record_mapping(node, cls, noun), cls))
+
+
+def write_fields(obj, skip: Iterable[str] = ()) -> dict[str, Any]:
+    """{YAML key: value} of the written fields of the record ``obj`` (tuples as lists), the
+    inverse of :func:`read_fields`; None values are left out (absent means None, or the value
+    derived from the others), as are ``omit_default`` fields at their default (as in the
+    resolved spec)."""
+    out = {}
+    for fi in written_fields(type(obj), skip):
+        v = getattr(obj, fi.name)
+        if v is None or fi.meta.omit_default and v == fi.default:
+            continue
+        out[fi.key] = plain_value(v)
+    return out
+
+
+def plain_value(x):
+    """Tuples as lists, numpy scalars as Python numbers (YAML-safe)."""
+    if isinstance(x, (tuple, list)):
+        return [plain_value(e) for e in x]
+    if hasattr(x, "tolist"):
+        return x.tolist()
+    return x
