@@ -10,7 +10,6 @@ code and names the field of a bad value (``<python>: objects[0].shape.radius: ex
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -88,11 +87,7 @@ def _geometry(g) -> tuple[str, Any]:
         if g.up_axis == mesh_up_axis(Path(path).suffix):
             return "mesh", path
         return "mesh", {"path": path, "up_axis": g.up_axis}
-    if g.kind in m.TARGET_KINDS:
-        names = [f.name for f in dataclasses.fields(g) if f.name != "kind"]
-        return "target", {"type": g.kind, **_fields(g, names)}
-    names = [f.name for f in dataclasses.fields(g) if f.name != "kind"]
-    return "shape", {"type": g.kind, **_fields(g, names)}
+    return "target" if g.kind in m.TARGET_KINDS else "shape", {"type": g.kind, **write_fields(g)}
 
 
 def _object(obj: m.SceneObject, materials) -> dict:

@@ -89,12 +89,14 @@ def read_given(f: Fields, cls: type, skip: Iterable[str] = ()) -> dict[str, Any]
             if fi.key in f}
 
 
-def check_keys(f: Fields, cls: type, skip: Iterable[str] = ()) -> Fields:
-    """``f`` with its keys checked against the written fields of ``cls`` (the required ones
-    first, then the others in declaration order)."""
-    required = required_keys(cls, skip)
-    return f.check(required=required,
-                   optional=[k for k in yaml_keys(cls, skip) if k not in required])
+def check_keys(f: Fields, cls: type, skip: Iterable[str] = (), *, required: Iterable[str] = (),
+               optional: Iterable[str] = ()) -> Fields:
+    """``f`` with its keys checked against the written fields of ``cls`` -- ``required`` (e.g.
+    ``type``) and the required fields first, then the others in declaration order, then
+    ``optional`` (keys the section reads by hand)."""
+    needed = tuple(required) + required_keys(cls, skip)
+    return f.check(required=needed, optional=[k for k in yaml_keys(cls, skip) if k not in needed]
+                   + [k for k in optional if k not in needed])
 
 
 def record_mapping(node: Node, cls: type, noun: str, skip: Iterable[str] = ()) -> Fields:

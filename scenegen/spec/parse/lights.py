@@ -9,7 +9,7 @@ from scenegen.spec.model import lights as ml
 from scenegen.spec.model.meta import WORLD_UP
 from scenegen.spec.model.views import LookAt
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.parse.fields import read_fields, required_keys, yaml_keys
+from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.read import read_float, read_vec3
 from scenegen.spec.parse.transforms import POSE_KEYS, aim, parse_rigid
 
@@ -29,9 +29,8 @@ def parse_light(node: Node, index: int, ctx: ParseContext) -> ml.Light:
     f = node.as_mapping("a light (a mapping with 'type')")
     kind = f.req("type").as_enum(ml.LIGHT_TYPES, "light type")
     C = CLASSES[kind]
-    extra = EXTRA_KEYS.get(kind, ())
-    f.check(required=("type",) + required_keys(C) + EXTRA_REQUIRED.get(kind, ()),
-            optional=yaml_keys(C) + extra)
+    check_keys(f, C, required=("type",) + EXTRA_REQUIRED.get(kind, ()),
+               optional=EXTRA_KEYS.get(kind, ()))
     name = f.get("name").as_name("a light name") if "name" in f else default_light_name(index)
     common = dict(name=name, where=node.where, **read_fields(f, C))
     if kind == "directional":

@@ -14,18 +14,15 @@ from scenegen.spec.model.materials import DiffuseMaterial, Material
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
-from scenegen.spec.parse.read import read_bool, read_enum, read_float, read_floats, read_int, seed_or_none
+from scenegen.spec.parse.fields import check_keys, read_fields
+from scenegen.spec.parse.read import read_float, read_int, seed_or_none
 from scenegen.spec.parse.timeline import ANIMATION_KEYS, parse_animation
 from scenegen.spec.parse.transforms import parse_transform
 
-#: The keys of each shape type, besides `type`.
-SHAPE_KEYS = {
-    "plane": ("size",), "box": ("size",), "sphere": ("radius",),
-    "cylinder": ("radius", "height"), "torus": ("major_radius", "minor_radius"),
-    "blob": ("radius", "amplitude", "frequency", "subdivisions", "seed"),
-}
 SHAPE_CLASSES = {"plane": mg.Plane, "box": mg.Box, "sphere": mg.Sphere, "cylinder": mg.Cylinder,
                  "torus": mg.Torus, "blob": mg.Blob}
+TARGET_CLASSES = {"checkerboard": mg.CheckerboardTarget, "charuco": mg.CharucoTarget,
+                  "aruco_grid": mg.ArucoGridTarget}
 
 
 def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
@@ -103,26 +100,17 @@ def parse_shape(node: Node, ctx: ParseContext) -> mg.Shape:
     if f is None:
         f = Fields.empty(node)
     else:
-        f.check(required=("type",), optional=SHAPE_KEYS[kind])
+        check_keys(f, SHAPE_CLASSES[kind], required=("type",))
     cls = SHAPE_CLASSES[kind]
-    if kind in ("plane", "box"):
-        return cls(size=read_floats(f, cls, "size", 2 if kind == "plane" else 3))
-    if kind == "sphere":
-        return cls(radius=read_float(f, cls, "radius"))
-    if kind == "cylinder":
-        return cls(radius=read_float(f, cls, "radius"), height=read_float(f, cls, "height"))
-    if kind == "torus":
-        major, minor = read_float(f, cls, "major_radius"), read_float(f, cls, "minor_radius")
-        if minor >= major:
-            bad = f.get("minor_radius") or f.get("major_radius") or node
-            raise bad.error(f"expected minor_radius < major_radius (a ring torus), got "
-                            f"minor_radius {minor:g} >= major_radius {major:g}")
-        return cls(major_radius=major, minor_radius=minor)
-    seed = seed_or_none(f, cls)
-    return cls(radius=read_float(f, cls, "radius"), amplitude=read_float(f, cls, "amplitude"),
-               frequency=read_float(f, cls, "frequency"),
-               subdivisions=read_int(f, cls, "subdivisions"),
-               seed=ctx.seed_for(node.path) if seed is None else seed)
+    values = read_fields(f, cls)
+    if kind == "torus" and values["minor_radius"] >= values["major_radius"]:
+        bad = f.get("minor_radius") or f.get("major_radius") or node
+        raise bad.error(f"expected minor_radius < major_radius (a ring torus), got minor_radius "
+                        f"{values['minor_radius']:g} >= major_radius {values['major_radius']:g}")
+    if kind == "blob":
+        seed = seed_or_none(f, cls)
+        values["seed"] = ctx.seed_for(node.path) if seed is None else seed
+    return cls(**values)
 
 
 def parse_target(node: Node) -> mg.Target:
@@ -139,43 +127,26 @@ def parse_target(node: Node) -> mg.Target:
 
 def _read_target(f: Fields) -> mg.Target:
     kind = f.req("type").as_enum(mg.TARGET_KINDS, "target type")
-    if kind == "checkerboard":
-        C = mg.CheckerboardTarget
-        f.check(required=("type", "inner_cols", "inner_rows", "square_m"), optional=("margin_m",))
-        square = read_float(f, C, "square_m")
-        return C(inner_cols=read_int(f, C, "inner_cols"), inner_rows=read_int(f, C, "inner_rows"),
-                 square_m=square, margin_m=read_float(f, C, "margin_m", default=square))
+    C = TARGET_CLASSES[kind]
+    check_keys(f, C, required=("type",))
+    values = read_fields(f, C)
     dict_node = f.get("dictionary")
+    if kind == "checkerboard":
+        return C(**values, margin_m=read_float(f, C, "margin_m", default=values["square_m"]))
+    dictionary = values["dictionary"]
     if kind == "charuco":
-        C = mg.CharucoTarget
-        f.check(required=("type", "squares_x", "squares_y", "square_m", "marker_m",
-                          "dictionary"), optional=("margin_m", "legacy_pattern"))
-        sx, sy = read_int(f, C, "squares_x"), read_int(f, C, "squares_y")
-        square = read_float(f, C, "square_m")
-        marker = read_float(f, C, "marker_m")
+        sx, sy, square, marker = (values[k] for k in ("squares_x", "squares_y", "square_m", "marker_m"))
         if marker >= square:
             raise f.get("marker_m").error(
                 f"expected marker_m < square_m ({square:g}), got {marker:g}")
-        dictionary = read_enum(f, C, "dictionary")
         needed = sx * sy // 2
         if needed > mg.ARUCO_DICTIONARIES[dictionary]:
             raise dict_node.error(f"{dictionary} holds {mg.ARUCO_DICTIONARIES[dictionary]} "
                                   f"markers; a {sx}x{sy} ChArUco board needs {needed}")
-        return C(squares_x=sx, squares_y=sy, square_m=square, marker_m=marker,
-                 dictionary=dictionary, margin_m=read_float(f, C, "margin_m", default=square),
-                 legacy_pattern=read_bool(f, C, "legacy_pattern"))
-    C = mg.ArucoGridTarget
-    f.check(required=("type", "markers_x", "markers_y", "marker_m", "separation_m",
-                      "dictionary"), optional=("first_id", "margin_m"))
-    mx, my = read_int(f, C, "markers_x"), read_int(f, C, "markers_y")
-    sep = read_float(f, C, "separation_m")
-    dictionary = read_enum(f, C, "dictionary")
-    first = read_int(f, C, "first_id")
+        return C(**values, margin_m=read_float(f, C, "margin_m", default=square))
+    mx, my, first = values["markers_x"], values["markers_y"], values["first_id"]
     size = mg.ARUCO_DICTIONARIES[dictionary]
     if first + mx * my > size:
         raise dict_node.error(f"{dictionary} holds {size} markers; a {mx}x{my} grid from id "
                               f"{first} needs {first + mx * my}")
-    return C(markers_x=mx, markers_y=my, marker_m=read_float(f, C, "marker_m"), separation_m=sep,
-             dictionary=dictionary, first_id=first,
-             margin_m=read_float(f, C, "margin_m", default=sep))
-
+    return C(**values, margin_m=read_float(f, C, "margin_m", default=values["separation_m"]))

@@ -15,7 +15,8 @@ from scenegen.errors import SpecError
 from scenegen.geometry import optics
 from scenegen.geometry.camera import MODEL_NAMES, MODELS
 from scenegen.geometry.color import BIT_DEPTHS
-from scenegen.imaging import RawOutput
+from scenegen.imaging import ExposureParams, ImagingParams, RawOutput, SensorParams
+from scenegen.imaging.vignetting import VignettingParams
 from scenegen.located_yaml import Document
 from scenegen.spec import model as m
 from scenegen.spec import parse_spec, reference
@@ -202,12 +203,31 @@ def test_parser_takes_the_default_from_the_dataclass(tmp_path, monkeypatch, cls,
     assert get(parse(text, tmp_path)) == other
 
 
+#: The imaging chain's records: an absent key keeps the value of the base record (a preset, or
+#: the record's own constructor default), so no parser reads their defaults; checked below.
+PRESET_BASED = {ImagingParams, ExposureParams, VignettingParams, SensorParams}
+
+
 def test_the_patch_test_covers_every_fixed_default():
     """Every spec value with a fixed (not derived, not None) default is in CASES."""
     covered = {(c[0], c[1]) for c in CASES}
-    fixed = {(cls, fi.name) for cls in reference.covered_classes() for fi in spec_fields(cls)
+    fixed = {(cls, fi.name) for cls in reference.covered_classes() - PRESET_BASED
+             for fi in spec_fields(cls)
              if not fi.meta.part and fi.default is not MISSING and fi.default is not None}
     assert fixed - covered == set(), sorted(f"{c.__name__}.{n}" for c, n in fixed - covered)
+
+
+def test_an_imaging_block_without_a_preset_has_the_documented_defaults(tmp_path):
+    """Without a preset every absent imaging value is its record's default as the reference
+    table states it (field_info), but the derived bit depth and fixed-pattern seed."""
+    cam = parse(CAM.replace("fx: 50", "fx: 50, imaging: {}"), tmp_path).cameras["cam"]
+    for cls in PRESET_BASED:
+        record = cam.imaging if cls is ImagingParams else getattr(
+            cam.imaging, {ExposureParams: "exposure", VignettingParams: "vignetting",
+                          SensorParams: "sensor"}[cls])
+        for fi in spec_fields(cls):
+            if not fi.meta.part and fi.default is not MISSING:
+                assert getattr(record, fi.name) == fi.default, (cls.__name__, fi.name)
 
 
 def test_a_reader_refuses_a_second_default():
