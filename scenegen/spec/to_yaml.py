@@ -42,10 +42,6 @@ def _matrix(pose) -> dict:
     return {"matrix": [[float(v) for v in row] for row in pose.matrix]}
 
 
-def _fields(obj, names) -> dict:
-    return {n: _v(getattr(obj, n)) for n in names}
-
-
 def _texture(t: m.Texture) -> dict:
     if t.kind == "image":
         return {"type": "image", "path": t.path_as_written or str(t.path)}
@@ -144,7 +140,7 @@ def _sequence(q: m.SequenceSpec) -> dict:
                          else {"timestamps_s": _v(q.timestamps_s)})
     d["flow_steps"] = _v(q.flow_steps)
     if q.tracks is not None:
-        d["tracks"] = _fields(q.tracks, ("count", "query_frames", "seed"))
+        d["tracks"] = write_fields(q.tracks)
     return d
 
 
@@ -200,17 +196,13 @@ def _placement(p, frame: str) -> tuple[str, Any]:
         return "poses", [{f"world_from_{frame}": [[float(v) for v in row] for row in w.matrix]}
                          for w in p.world_from_cam]
     if isinstance(p, m.RandomPoses):
-        return "random", {"count": p.count, "seed": p.seed,
-                          "eye_box": {"min": _v(p.eye_min), "max": _v(p.eye_max)},
-                          "target_box": {"min": _v(p.target_min), "max": _v(p.target_max)},
-                          "up": _v(p.up), "min_distance_m": p.min_distance_m}
+        return "random", {**write_fields(p), "eye_box": write_fields(p, within="eye_box"),
+                          "target_box": write_fields(p, within="target_box")}
     if isinstance(p, m.TrajectoryPath):
         return "trajectory", _trajectory(p.trajectory, frame)
     if isinstance(p, m.LinePath):
-        return "path", {"line": {"from": _v(p.start), "to": _v(p.end)}, "count": p.count,
-                        "target": _v(p.target), "up": _v(p.up)}
-    return "path", {"circle": _fields(p, ("center", "radius_m", "height_m", "start_azimuth_deg")),
-                    "count": p.count, "target": _v(p.target), "up": _v(p.up)}
+        return "path", {"line": write_fields(p, within="line"), **write_fields(p)}
+    return "path", {"circle": write_fields(p, within="circle"), **write_fields(p)}
 
 
 def _view_set(vs: m.ViewSet) -> dict:

@@ -52,11 +52,11 @@ class PoseList:
 class RandomPoses:
     count: int = param(**_COUNT)  # number of views
     seed: int = param(**_SEED)
-    eye_min: tuple[float, float, float] = param(unit=_M)  # eye box corner (YAML eye_box.min)
-    eye_max: tuple[float, float, float] = param(unit=_M)
-    target_min: tuple[float, float, float] = param(unit=_M)  # target box (min == max for a
-    # fixed target)
-    target_max: tuple[float, float, float] = param(unit=_M)
+    eye_min: tuple[float, float, float] = param(unit=_M, key="eye_box.min")  # eye box corner
+    eye_max: tuple[float, float, float] = param(unit=_M, key="eye_box.max")
+    target_min: tuple[float, float, float] = param(unit=_M, key="target_box.min")  # target box
+    # (min == max for a fixed target: YAML `target`)
+    target_max: tuple[float, float, float] = param(unit=_M, key="target_box.max")
     up: tuple[float, float, float] = param(WORLD_UP, **_UP)
     min_distance_m: float = param(0.0, unit=_M, lo=0.0)  # eye-target distances below this are
     # redrawn
@@ -65,8 +65,8 @@ class RandomPoses:
 
 @dataclass(frozen=True, kw_only=True)
 class LinePath:
-    start: tuple[float, float, float] = param(unit=_M)  # first eye (YAML `from`)
-    end: tuple[float, float, float] = param(unit=_M)  # last eye (YAML `to`)
+    start: tuple[float, float, float] = param(unit=_M, key="line.from")  # first eye
+    end: tuple[float, float, float] = param(unit=_M, key="line.to")  # last eye
     count: int = param(**_COUNT)  # eyes evenly spaced from start to end, both included
     target: tuple[float, float, float] = param(unit=_M)
     up: tuple[float, float, float] = param(WORLD_UP, **_UP)
@@ -75,11 +75,13 @@ class LinePath:
 
 @dataclass(frozen=True, kw_only=True)
 class CirclePath:
-    center: tuple[float, float, float] = param((0.0, 0.0, 0.0), unit=_M)  # circle centre
-    radius_m: float = param(**_POS_M)
-    height_m: float = param(0.0, unit=_M)  # eyes at center + (r cos a, r sin a, height_m)
+    center: tuple[float, float, float] = param((0.0, 0.0, 0.0), unit=_M, key="circle.center")
+    radius_m: float = param(**_POS_M, key="circle.radius_m")
+    height_m: float = param(0.0, unit=_M, key="circle.height_m")  # eyes at center + (r cos a,
+    # r sin a, height_m)
     count: int = param(**_COUNT)  # eyes evenly spaced over 360 degrees (the start not repeated)
-    start_azimuth_deg: float = param(0.0, unit="degrees")  # from +x toward +y
+    start_azimuth_deg: float = param(0.0, unit="degrees", key="circle.start_azimuth_deg")  # from
+    # +x toward +y
     target: tuple[float, float, float] = param(unit=_M, derived="center")
     up: tuple[float, float, float] = param(WORLD_UP, **_UP)
     kind: str = field(default="circle", init=False)

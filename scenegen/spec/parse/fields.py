@@ -68,17 +68,30 @@ def required_keys(cls: type, skip: Iterable[str] = ()) -> tuple[str, ...]:
     return tuple(fi.key for fi in written_fields(cls, skip) if fi.required)
 
 
-def read_field(f: Fields, fi: FieldInfo) -> Any:
-    """The field's value in ``f``, or its default when absent (None when required: the key
-    check has then already failed)."""
-    node = value_node(f, fi.key, fi)
+def nested_fields(cls: type, within: str) -> list[tuple[str, FieldInfo]]:
+    """(key inside ``within``, field) of the fields of ``cls`` written as ``<within>.<key>``
+    (e.g. ``circle.radius_m``: a value of a nested mapping the section checks by hand)."""
+    n = len(within) + 1
+    return [(fi.key[n:], fi) for fi in spec_fields(cls)
+            if not fi.meta.part and fi.key.startswith(within + ".")]
+
+
+def read_field(f: Fields, fi: FieldInfo, key: str | None = None) -> Any:
+    """The field's value in ``f`` (under ``key``, default its own), or its default when absent
+    (None when required: the key check has then already failed)."""
+    node = value_node(f, key or fi.key, fi)
     if node is None:
         return None if fi.required else fi.default
     return read_value(node, fi)
 
 
-def read_fields(f: Fields, cls: type, skip: Iterable[str] = ()) -> dict[str, Any]:
-    """{field name: value or default} of every plain field of ``cls`` not in ``skip``."""
+def read_fields(f: Fields, cls: type, skip: Iterable[str] = (), *,
+                within: str | None = None) -> dict[str, Any]:
+    """{field name: value or default} of every plain field of ``cls`` not in ``skip``; with
+    ``within``, of the fields written inside that nested mapping (``f`` is that mapping)."""
+    if within is not None:
+        return {fi.name: read_field(f, fi, key) for key, fi in nested_fields(cls, within)
+                if fi.name not in set(skip) and fi.meta.derived is None}
     return {fi.name: read_field(f, fi) for fi in plain_fields(cls, skip)}
 
 
@@ -110,17 +123,19 @@ def parse_record(node: Node, cls: type, noun: str):
     return cls(**read_fields(record_mapping(node, cls, noun), cls))
 
 
-def write_fields(obj, skip: Iterable[str] = ()) -> dict[str, Any]:
+def write_fields(obj, skip: Iterable[str] = (), *, within: str | None = None) -> dict[str, Any]:
     """{YAML key: value} of the written fields of the record ``obj`` (tuples as lists), the
-    inverse of :func:`read_fields`; None values are left out (absent means None, or the value
-    derived from the others), as are ``omit_default`` fields at their default (as in the
-    resolved spec)."""
+    inverse of :func:`read_fields` (``within``: of those inside that nested mapping); None
+    values are left out (absent means None, or the value derived from the others), as are
+    ``omit_default`` fields at their default (as in the resolved spec)."""
+    pairs = (nested_fields(type(obj), within) if within is not None
+             else [(fi.key, fi) for fi in written_fields(type(obj))])
     out = {}
-    for fi in written_fields(type(obj), skip):
+    for key, fi in pairs:
         v = getattr(obj, fi.name)
-        if v is None or fi.meta.omit_default and v == fi.default:
+        if fi.name in skip or v is None or fi.meta.omit_default and v == fi.default:
             continue
-        out[fi.key] = plain_value(v)
+        out[key] = plain_value(v)
     return out
 
 

@@ -10,7 +10,7 @@ from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.optics import parse_motion
-from scenegen.spec.parse.read import read_float, read_int, read_vec3, seed_or_none
+from scenegen.spec.parse.read import read_vec3, seed_or_none
 from scenegen.spec.parse.timeline import parse_trajectory
 from scenegen.spec.parse.transforms import parse_pose
 
@@ -156,9 +156,8 @@ def parse_random(node: Node, frame: str, ctx: ParseContext) -> mv.RandomPoses:
     else:
         t_min, t_max = parse_box(f.get("target_box"))
     seed = seed_or_none(f, R)
-    return R(count=read_int(f, R, "count"), seed=ctx.seed_for(node.path) if seed is None else seed,
-             eye_min=eye_min, eye_max=eye_max, target_min=t_min, target_max=t_max,
-             up=read_vec3(f, R, "up"), min_distance_m=read_float(f, R, "min_distance_m"))
+    return R(**read_fields(f, R), seed=ctx.seed_for(node.path) if seed is None else seed,
+             eye_min=eye_min, eye_max=eye_max, target_min=t_min, target_max=t_max)
 
 
 def parse_box(node: Node):
@@ -177,18 +176,13 @@ def parse_path(node: Node, frame: str, ctx: ParseContext):
     which = f.one_of(("line", "circle"))
     if which == "line":
         L = mv.LinePath
-        up = read_vec3(f, L, "up")
         lf = f.get("line").as_mapping("a line {from, to}").check(required=("from", "to"))
         if "target" not in f:
             raise f.missing("target", " (a line path looks at a fixed target)")
-        return L(start=read_vec3(lf, L, "start", "from"), end=read_vec3(lf, L, "end", "to"),
-                 count=read_int(f, L, "count"), target=read_vec3(f, L, "target"), up=up)
+        return L(**read_fields(lf, L, within="line"), **read_fields(f, L))
     C = mv.CirclePath
-    up = read_vec3(f, C, "up")
     cf = f.get("circle").as_mapping("a circle {center, radius_m, height_m}").check(
         required=("radius_m",), optional=("center", "height_m", "start_azimuth_deg"))
-    center = read_vec3(cf, C, "center")
-    return C(center=center, radius_m=read_float(cf, C, "radius_m"),
-             height_m=read_float(cf, C, "height_m"), count=read_int(f, C, "count"),
-             start_azimuth_deg=read_float(cf, C, "start_azimuth_deg"),
-             target=read_vec3(f, C, "target", default=center), up=up)
+    circle = read_fields(cf, C, within="circle")
+    return C(**circle, **read_fields(f, C),
+             target=read_vec3(f, C, "target", default=circle["center"]))
