@@ -113,3 +113,28 @@ def test_every_written_field_of_the_generated_sections_is_accepted_and_documente
                   for _, key, *_ in reference.rows(((c, where, k),))}
     assert {fi.key for fi in fields} <= documented
 
+
+
+@dataclass(frozen=True, kw_only=True)
+class Ring:
+    """A record with values inside a nested mapping (``circle: {radius_m, center}``)."""
+
+    radius_m: float = param(unit="metres", lo=0.0, lo_open=True, key="circle.radius_m")
+    center: tuple[float, float, float] = param((0.0, 0.0, 0.0), unit="metres",
+                                               key="circle.center")
+    count: int = param(3, unit="views", lo=1)
+
+
+def test_nested_keys_are_read_and_written_inside_their_mapping():
+    root = Document("circle: {radius_m: 2}\ncount: 5\n", "r.yaml", Path(".")).root.as_mapping()
+    circle = root.get("circle").as_mapping()
+    ring = Ring(**read_fields(circle, Ring, within="circle"), **read_fields(root, Ring))
+    assert ring == Ring(radius_m=2.0, count=5)
+    assert write_fields(ring) == {"count": 5}
+    assert write_fields(ring, within="circle") == {"radius_m": 2.0, "center": [0.0, 0.0, 0.0]}
+    bad = Document("circle: {radius_m: -1}\n", "r.yaml", Path(".")).root.as_mapping()
+    with pytest.raises(SpecError, match=r"^r.yaml:1: circle.radius_m: expected a value > 0 "
+                                        r"\(metres\), got -1"):
+        read_fields(bad.get("circle").as_mapping(), Ring, within="circle")
+    keys = {key for _, key, *_ in reference.rows(((Ring, "ring", {}),))}
+    assert keys == {"circle.radius_m", "circle.center", "count"}
