@@ -23,8 +23,8 @@ Modules, by idea: :mod:`.meta` (field metadata), :mod:`.render`, :mod:`.material
 (cameras, rigs), :mod:`.views` (view sets, views), :mod:`.crossview`, :mod:`.variation`,
 :mod:`.timeline` (sequence clock, trajectories, joints, tracks), :mod:`.scene` (SceneSpec). This package re-exports them all.
 """
-from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
 from scenegen.spec.model import imaging as _imaging  # noqa: F401 (describes the imaging records)
+from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
 from scenegen.spec.model.crossview import CROSSVIEW_PAIR_MODES, CrossviewSpec, MatchSetSpec
 from scenegen.spec.model.geometry import (
     ARUCO_DICTIONARIES, MESH_SUFFIXES, AssetFile, SHAPE_KINDS, TARGET_KINDS, ArucoGridTarget, Blob, Box,

@@ -12,9 +12,9 @@ from scenegen.spec.model.cameras import CameraSpec
 from scenegen.spec.model.limits import MAX_IMAGE_PIXELS
 from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.fields import read_fields, yaml_keys
 from scenegen.spec.parse.imaging import parse_imaging
 from scenegen.spec.parse.optics import OPTICS_KEYS, parse_optics
-from scenegen.spec.parse.fields import read_fields, yaml_keys
 from scenegen.spec.parse.read import read_float
 
 #: The written fields' keys (size, the focal lengths, principal point and dist read by hand:

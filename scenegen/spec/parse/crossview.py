@@ -6,9 +6,9 @@ from typing import Sequence
 
 from scenegen.located_yaml import Node, suggest
 from scenegen.spec.model.crossview import CrossviewSpec, MatchSetSpec
+from scenegen.spec.model.meta import spec_fields
 from scenegen.spec.model.views import View
 from scenegen.spec.parse.context import ParseContext
-from scenegen.spec.model.meta import spec_fields
 from scenegen.spec.parse.fields import read_fields, yaml_keys
 from scenegen.spec.parse.read import read_enum, seed_or_none
 

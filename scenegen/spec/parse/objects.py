@@ -12,9 +12,9 @@ from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
 from scenegen.spec.parse.context import ParseContext
+from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
-from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.read import read_float, read_int, seed_or_none
 from scenegen.spec.parse.timeline import ANIMATION_KEYS, parse_animation
 from scenegen.spec.parse.transforms import parse_transform

@@ -16,8 +16,7 @@ from scenegen.geometry import optics
 from scenegen.imaging import ExposureParams, RawOutput, SensorParams
 from scenegen.imaging.vignetting import VignettingParams
 from scenegen.located_yaml import Document
-from scenegen.spec import model as m
-from scenegen.spec import reference
+from scenegen.spec import model as m, reference
 from scenegen.spec.model.meta import param, spec_fields
 from scenegen.spec.parse import crossview, imaging, lights, materials, render, truth
 from scenegen.spec.parse.fields import read_fields, record_mapping, write_fields, written_fields
