@@ -167,7 +167,7 @@ class FieldInfo:
 
     @property
     def kind(self) -> str:
-        return value_kind(self.owner, self.name)
+        return value_kind(self.owner, self.name, self.meta)
 
 
 def spec_meta(cls: type, f: dataclasses.Field) -> Meta | None:
@@ -179,12 +179,16 @@ def spec_meta(cls: type, f: dataclasses.Field) -> Meta | None:
 def field_info(cls: type, name: str) -> FieldInfo:
     """Default and metadata of field ``name`` of ``cls`` (a spec dataclass, or a foreign one
     described with :func:`describe_foreign`)."""
-    f = {f.name: f for f in dataclasses.fields(cls)}.get(name)
+    f = next((f for f in dataclasses.fields(cls) if f.name == name), None)
     if f is None:
         raise AttributeError(f"{cls.__name__} has no field {name!r}")
     meta_ = spec_meta(cls, f)
     if meta_ is None:
         raise TypeError(f"{cls.__name__}.{name} has no spec metadata (declare it with param())")
+    return _info(cls, f, meta_)
+
+
+def _info(cls: type, f: dataclasses.Field, meta_: Meta) -> FieldInfo:
     if meta_.derived is not None:
         default = MISSING
     elif meta_.yaml_default is not NOT_GIVEN:
@@ -195,7 +199,7 @@ def field_info(cls: type, name: str) -> FieldInfo:
         default = f.default_factory()
     else:
         default = MISSING
-    return FieldInfo(owner=cls, name=name, meta=meta_, default=default)
+    return FieldInfo(owner=cls, name=f.name, meta=meta_, default=default)
 
 
 _SCALARS = {float: "float", int: "int", bool: "bool", str: "str"}
@@ -206,11 +210,12 @@ def _hints(cls: type) -> dict:
     return typing.get_type_hints(cls)
 
 
-def value_kind(cls: type, name: str) -> str:
+def value_kind(cls: type, name: str, meta_: Meta | None = None) -> str:
     """How field ``name`` of ``cls`` is read: 'enum' (it has choices), the Meta's ``kind``, else
     from its annotation (None allowed aside): 'float', 'int', 'bool', 'str', or 'floats' for a
-    tuple of floats (its length from the annotation, or Meta.count)."""
-    m = field_info(cls, name).meta
+    tuple of floats (its length from the annotation, or Meta.count). ``meta_``: the field's, if
+    known."""
+    m = meta_ or field_info(cls, name).meta
     if m.choices:
         return "enum"
     if m.kind:
@@ -242,8 +247,5 @@ def value_count(cls: type, name: str):
 
 def spec_fields(cls: type) -> list[FieldInfo]:
     """Every field of ``cls`` that carries spec metadata, in declaration order."""
-    out = []
-    for f in dataclasses.fields(cls):
-        if META_KEY in f.metadata or f.name in _FOREIGN.get(cls, {}):
-            out.append(field_info(cls, f.name))
-    return out
+    return [_info(cls, f, m) for f in dataclasses.fields(cls)
+            if (m := spec_meta(cls, f)) is not None]
