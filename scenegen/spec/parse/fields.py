@@ -126,14 +126,13 @@ def parse_record(node: Node, cls: type, noun: str):
 def write_fields(obj, skip: Iterable[str] = (), *, within: str | None = None) -> dict[str, Any]:
     """{YAML key: value} of the written fields of the record ``obj`` (tuples as lists), the
     inverse of :func:`read_fields` (``within``: of those inside that nested mapping); None
-    values are left out (absent means None, or the value derived from the others), as are
-    ``omit_default`` fields at their default (as in the resolved spec)."""
+    values are left out (absent means None, or the value derived from the others)."""
     pairs = (nested_fields(type(obj), within) if within is not None
              else [(fi.key, fi) for fi in written_fields(type(obj))])
     out = {}
     for key, fi in pairs:
         v = getattr(obj, fi.name)
-        if fi.name in skip or v is None or fi.meta.omit_default and v == fi.default:
+        if fi.name in skip or v is None:
             continue
         out[key] = plain_value(v)
     return out
