@@ -1,9 +1,12 @@
-"""Rolling shutter: poses tabulated per image row, and where a rolling-shutter camera images a point.
+"""Rolling shutter: rows as times, poses tabulated per image row, and where a rolling-shutter
+camera images a point.
 
 Row ``v`` (continuous, OpenCV pixel rows, 0 = top) of a frame is exposed around
-``tau(v) = Shutter.row_time_s(v, H)`` seconds from the frame's time (its middle row at 0; the one
+``tau(v) = Shutter.row_times_s(v, H)`` seconds from the frame's time (its middle row at 0; the one
 definition, :mod:`scenegen.geometry.optics`; the renderer's sensor times its samples by the same
-line). Poses within a frame (the camera's ``world_from_cam``, a moving object's
+line); :class:`RowClock` puts the rows on the sequence clock (:mod:`scenegen.geometry.clock`), so a
+table is a trajectory evaluated at the row times (:meth:`RowPoses.of_trajectory`) and is read
+by row or by time. Poses within a frame (the camera's ``world_from_cam``, a moving object's
 ``world_from_object``: a frame's rotation and its origin's path) are tabulated at the row
 centres from one row above the image to one below, nodes ``v = -1 .. H``, plus a node (a knot)
 at the row of every keyframe time that falls inside the frame's readout, where a path's velocity
