@@ -96,12 +96,7 @@ class Timeline:
     def knot_times_s(self) -> np.ndarray:
         """(K,) sorted times at which some object's motion may have a velocity jump (its own or
         a parent's keyframes, :attr:`scenegen.geometry.trajectory.KeyframeTrajectory.knot_times_s`)."""
-        times = []
-        for obj in self.objects:
-            if is_animated(obj):
-                if obj.name not in self._cache:
-                    self._cache[obj.name] = local_trajectory(obj.animation)
-                times.append(np.asarray(getattr(self._cache[obj.name], "knot_times_s", ()), np.float64))
+        times = [np.asarray(self._local(obj).knot_times_s, np.float64) for obj in self.objects if is_animated(obj)]
         return np.unique(np.concatenate(times)) if times else np.empty(0)
 
     def _local(self, obj):
@@ -114,7 +109,9 @@ class Timeline:
         (its local trajectory under its parents'; a static object's fixed ``transform``)."""
         obj = next(o for o in self.objects if o.name == name)
         if not is_animated(obj):
-            return StaticTrajectory(obj.transform.world_from_object)
+            motion = getattr(obj, "motion", None)  # a still spec's clock: 0 at each view's mid-exposure
+            return (motion.object_trajectory(obj.transform.world_from_object) if moves_within_frame(obj)
+                    else StaticTrajectory(obj.transform.world_from_object))
         local = self._local(obj)
         parent = obj.animation.parent
         return Composed(self.object_trajectory(parent), local) if parent is not None else local
@@ -129,11 +126,12 @@ class Timeline:
         return own & self.presence_at(a.parent, t) if a is not None and a.parent is not None else own
 
     def object_moves_at_times(self, times_s) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """{object id: ((N, 3, 3) R, (N, 3) t world_from_object, (N,) present)} of every animated
-        object at times (N,) seconds on the clock, one per ray (vectorised over the times)."""
+        """{object id: ((N, 3, 3) R, (N, 3) t world_from_object, (N,) present)} of every object
+        that moves (:func:`moves_within_frame`) at times (N,) seconds on the clock, one per ray
+        (vectorised over the times)."""
         out = {}
         for o in self.objects:
-            if is_animated(o):
+            if moves_within_frame(o):
                 out[o.object_id] = (*self.object_trajectory(o.name).poses_at(times_s), self.presence_at(o.name, times_s))
         return out
 
