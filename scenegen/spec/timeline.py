@@ -132,7 +132,8 @@ class Timeline:
         out = {}
         for o in self.objects:
             if moves_within_frame(o):
-                out[o.object_id] = (*self.object_trajectory(o.name).poses_at(times_s), self.presence_at(o.name, times_s))
+                R, t = self.object_trajectory(o.name).poses_at(times_s)
+                out[o.object_id] = (R, t, self.presence_at(o.name, times_s))
         return out
 
     def poses_by_id(self, t_s: float) -> dict[int, tuple[Rigid3, bool]]:

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from scenegen.geometry.clock import Composed, ConstantTwist, Shifted, StaticTrajectory, Trajectory
 from scenegen.geometry.optics import Motion, PathMotion, cam_from_world_at, world_from_object_at
 from scenegen.geometry.pose import Rigid3
-from scenegen.geometry.trajectory import JointTrajectory, KeyframeTrajectory, MotionState
+from scenegen.geometry.trajectory import JointTrajectory, KeyframeTrajectory
 
 TIMES = np.array([0.0, 0.4, 0.9, 1.3, 2.0])
 RNG = np.random.default_rng(26)
@@ -175,4 +175,3 @@ def test_path_motion_and_composition():
     for k, tau in enumerate(taus):
         want = pm.world_from_cam(float(tau))
         assert np.abs(R[k] - want.R).max() < 1e-14 and np.abs(t[k] - want.t).max() < 1e-14
-    assert isinstance(MotionState.still(x_from_cam), MotionState)
