@@ -12,6 +12,18 @@ from recon_eval.report.html import Figure
 
 #: Errors above this (the kind's unit) are drawn at it in the plots.
 PLOT_CEILING_PX = 1000.0
+#: What a sweep document written before the sweep kinds reports (F alone, ``breakdown_px``).
+F_ERROR = {"kind": "f", "label": "fundamental matrix", "measure": "distance of the truth points to the estimated "
+           "epipolar lines, px", "unit": "px", "mean_key": "epi_mean_px", "std_key": "epi_std_px",
+           "median_key": "median_trial_epi_px"}
+
+
+def _error(results: dict) -> dict:
+    return results.get("error", F_ERROR)
+
+
+def _threshold(cfg: dict) -> float:
+    return cfg["breakdown"] if "breakdown" in cfg else cfg["breakdown_px"]
 
 
 def _px(v) -> str:
@@ -30,7 +42,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str
     """Rows: methods; columns: the swept sigmas at ``outlier_fraction`` (or the fractions at
     ``sigma_px``); each entry ``mean ± std`` of the kind's error (F: px of the distances to the
     epipolar lines), or the cell's ``key`` (e.g. ``pose_err_deg``) when given."""
-    cells, err = results["cells"], results["error"]
+    cells, err = results["cells"], _error(results)
     if outlier_fraction is not None:
         cells = [c for c in cells if c["outlier_fraction"] == outlier_fraction]
         axis, head = "sigma_px", "sigma {} px"
@@ -73,8 +85,8 @@ def breakdown_table(results: dict) -> str:
 def markdown(results: dict) -> str:
     """Every table of a sweep: per outlier fraction (error vs noise), per sigma (error vs outliers),
     and the breakdown points."""
-    cfg, err = results["config"], results["error"]
-    parts = [f"Breakdown: the smallest outlier fraction whose median trial error exceeds {cfg['breakdown']} "
+    cfg, err = results["config"], _error(results)
+    parts = [f"Breakdown: the smallest outlier fraction whose median trial error exceeds {_threshold(cfg)} "
              f"{err['unit']}.", "", breakdown_table(results), ""]
     what = ("the truth points' distances to the epipolar lines" if err["kind"] == "f"
             else f"the per-trial {err['measure'].split(',')[0]}")
@@ -91,7 +103,7 @@ def markdown(results: dict) -> str:
 def figures(results: dict) -> list[Figure]:
     """Error against noise (no outliers), and against the outlier fraction at each sigma, one panel per
     method family."""
-    cells, cfg, err = results["cells"], results["config"], results["error"]
+    cells, cfg, err = results["cells"], results["config"], _error(results)
     fam = {c["method"]: c["family"] for c in cells}
     unit = err["unit"]
     what = "distance to epipolar line" if err["kind"] == "f" else err["measure"].split(",")[0].split(":")[0]
@@ -112,5 +124,5 @@ def figures(results: dict) -> list[Figure]:
         figs.append(Figure(f"Error against outliers, sigma {s:g} px", plots.panels_figure(
             fr, panels("sigma_px", s, "outlier_fraction", err["median_key"]), xlabel="outlier fraction",
             ylabel=f"median trial error ({unit})", title=f"sigma {s:g} px", ceiling=PLOT_CEILING_PX,
-            hline=cfg["breakdown"]), f"dashed: the breakdown threshold {cfg['breakdown']:g} {unit}"))
+            hline=_threshold(cfg)), f"dashed: the breakdown threshold {_threshold(cfg):g} {unit}"))
     return figs
