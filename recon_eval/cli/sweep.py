@@ -35,6 +35,9 @@ def arguments(p) -> None:
     p.add_argument("--views", nargs="+", metavar="VIEW",
                    help="the pair VIEW1 VIEW2 (default: the first cross-view pair); --kind pnp: one view (default: "
                         "the first)")
+    p.add_argument("--object", metavar="NAME", dest="object_name",
+                   help="--kind h, e, pnp, triangulation: only the truth points on this spec object (--kind h: a "
+                        "planar object of a larger scene)")
     p.add_argument("--sigmas", type=float, nargs="+", default=[0.0, 0.5, 1.0, 2.0], metavar="PX",
                    help="Gaussian noise per coordinate, px (default 0 0.5 1 2)")
     p.add_argument("--outliers", type=float, nargs="+", default=[0.0, 0.1, 0.2, 0.3, 0.4, 0.5], metavar="F",
@@ -83,7 +86,7 @@ def run(a) -> int:
     methods = kind.resolve(names, declared, notes)
     ds = read_dataset(a.dataset)
     views = _views(a, ds, kind)
-    truth = kind.truth(ds, views, TRUTH_POOL)
+    truth = kind.truth(ds, views, TRUTH_POOL, a.object_name)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     say = None if a.quiet else (lambda s: print(f"recon-eval sweep: {s}", file=sys.stderr))

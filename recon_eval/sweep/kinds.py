@@ -5,6 +5,7 @@ methods and its error (:class:`recon_eval.sweep.kind.SweepKind`); :mod:`.run` sw
 same way."""
 from __future__ import annotations
 
+from recon_eval.errors import InputError
 from recon_eval.sweep.draw import draw_trial
 from recon_eval.sweep.kind import SweepKind
 from recon_eval.sweep.methods import all_survey, resolve
@@ -14,7 +15,9 @@ from recon_eval.sweep.summary import score_trial, summarise_cell
 from recon_eval.tasks.fmatrix_pair import pair_truth
 
 
-def _f_truth(ds, views, pool):
+def _f_truth(ds, views, pool, obj=None):
+    if obj is not None:
+        raise InputError("--object: not for --kind f (its truth is the pair's stored correspondences)")
     return pair_truth(ds, *views, pixels="undistorted", max_points=pool)
 
 

@@ -68,8 +68,8 @@ def _notes(extra: dict):
 
 
 # --- homographies ---------------------------------------------------------------------------------
-def h_truth(ds, views, pool):
-    t = pair_points(ds, *views, pool, baseline=False)
+def h_truth(ds, views, pool, obj=None):
+    t = pair_points(ds, *views, pool, obj, baseline=False)
     p1 = t.cam_from_world[0]
     n, d, res = plane_of(p1.apply(t.X), PLANAR_REL_TOL)
     H = plane_homography(t.K[0], t.K[1], t.cam2_from_cam1, n, d)
@@ -157,6 +157,10 @@ def tri_score(X_est, trial, truth) -> dict:
             "failure_reason": f"{s.n_failed} points not triangulated" if failed else None}
 
 
+def _with_baseline(ds, views, pool, obj=None):
+    return pair_points(ds, *views, pool, obj, baseline=True)
+
+
 def _kind(name, label, stream, measure, key, unit, extras, min_inl, breakdown, truth, score, methods, notes):
     return SweepKind(
         name, label, stream, measure, key, unit, (f"mean_{key}", f"std_{key}", f"median_trial_{key}"), min_inl,
@@ -170,9 +174,9 @@ H_KIND = _kind("h", "homography", "h-sweep", "mean corner error (MACE) of the es
 E_KIND = _kind("e", "essential matrix", "e-sweep", "pose error through the truth K: max of the rotation and "
                "translation-direction errors, deg", "pose_err_deg", "deg",
                ("rot_err_deg", "trans_dir_err_deg", "epi_mean_px"), 5, 5.0,
-               lambda ds, views, pool: pair_points(ds, *views, pool, baseline=True), e_score, E_METHODS, {})
+               _with_baseline, e_score, E_METHODS, {})
 TRI_KIND = _kind("triangulation", "two-view triangulation", "triangulation-sweep",
                  "mean 3D error of the inlier rows' triangulated points against the truth points, m", "err_m", "m",
                  ("median_err_m", "mean_rel_err"), 1, 0.05,
-                 lambda ds, views, pool: pair_points(ds, *views, pool, baseline=True), tri_score, TRI_METHODS,
+                 _with_baseline, tri_score, TRI_METHODS,
                  {"outliers": "an outlier's image-2 pixel is uniform over image 2; its point is not scored"})

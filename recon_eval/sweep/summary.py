@@ -77,8 +77,9 @@ def breakdown_points(cells: list[dict], breakdown_px: float, key: str = "median_
     fraction swept."""
     out = {}
     for c in sorted(cells, key=lambda c: c["outlier_fraction"]):
-        row = out.setdefault((c["method"], c["sigma_px"]), {"method": c["method"], "family": c["family"],
-                                                            "sigma_px": c["sigma_px"], "breakdown_fraction": None, "max_fraction_swept": c["outlier_fraction"]})
+        row = out.setdefault((c["method"], c["sigma_px"]), {
+            "method": c["method"], "family": c["family"], "sigma_px": c["sigma_px"], "breakdown_fraction": None,
+            "max_fraction_swept": c["outlier_fraction"]})
         row["max_fraction_swept"] = c["outlier_fraction"]
         if row["breakdown_fraction"] is None and not c[key] <= breakdown_px:
             row["breakdown_fraction"] = c["outlier_fraction"]

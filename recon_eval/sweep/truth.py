@@ -8,7 +8,10 @@ docs/metrics.md), so a pixel and its point agree to float64 rounding whatever th
 did to the point. A pair's points are those the second view sees (the dataset's ray-cast
 visibility, :func:`recon_eval.tasks.triangulation_task.visible_truth_points`); a view's are its
 valid pixel centres (:meth:`DatasetTruth.points_at_pixels`). Both are a seeded sample of at most
-``pool`` points (seed 0: the truth does not move with the sweep's seed).
+``pool`` points (seed 0: the truth does not move with the sweep's seed). With ``obj`` (``--object
+NAME``) only the points whose first-view pixel sees that spec object are kept (the view's
+``object_id`` truth at the point's pixel): a planar object of a larger scene for H, one object for
+PnP.
 """
 from __future__ import annotations
 
@@ -43,6 +46,20 @@ class ViewsTruth:
         return self.cam_from_world[1] @ self.cam_from_world[0].inverse()
 
 
+def _on_object(ds, view: str, X: np.ndarray, obj: str | None, how: str) -> tuple[np.ndarray, str]:
+    """The rows of X (points at ``view``'s pixel centres) whose pixel sees the object ``obj``."""
+    if obj is None:
+        return X, how
+    oid = ds.object_id(obj)
+    cam, pose = ds.camera(view)
+    uv = np.nan_to_num(np.asarray(cam.project(pose.apply(X)), np.float64), nan=-1.0)
+    u, v = (np.clip(np.rint(uv[:, k]).astype(np.int64), 0, n - 1) for k, n in ((0, cam.width), (1, cam.height)))
+    keep = ds.object_ids(view)[v, u] == oid
+    if not keep.any():
+        raise InputError(f"--object {obj}: no truth point of view {view!r} lies on it")
+    return X[keep], f"{how}, on object {obj!r}"
+
+
 def _build(ds, views: tuple, X: np.ndarray, how: str) -> ViewsTruth:
     cams = [ds.camera(v) for v in views]
     P = tuple(projection_matrix(c.K, p.R, p.t) for c, p in cams)
@@ -53,7 +70,7 @@ def _build(ds, views: tuple, X: np.ndarray, how: str) -> ViewsTruth:
                       tuple((c.width, c.height) for c, _ in cams), notes)
 
 
-def pair_points(ds, view1: str, view2: str, pool: int, *, baseline: bool) -> ViewsTruth:
+def pair_points(ds, view1: str, view2: str, pool: int, obj: str | None = None, *, baseline: bool) -> ViewsTruth:
     """The truth of the pair ``view1 -> view2`` (module docstring); with ``baseline`` the two camera
     centres must differ (E and triangulation: no epipolar geometry, no depth otherwise)."""
     views = (ds.check_view(view1), ds.check_view(view2))
@@ -62,20 +79,20 @@ def pair_points(ds, view1: str, view2: str, pool: int, *, baseline: bool) -> Vie
     X = np.asarray(visible_truth_points(ds, *views, pool), np.float64)
     if len(X) == 0:
         raise InputError(f"{ds.root}: views {view1!r} and {view2!r} share no visible truth point")
-    t = _build(ds, views, X, "truth points of view 1 that view 2 sees (seeded sample)")
+    t = _build(ds, views, *_on_object(ds, views[0], X, obj, "truth points of view 1 that view 2 sees (seeded sample)"))
     if baseline and np.linalg.norm(t.cam2_from_cam1.t) < ZERO_BASELINE_M:
         raise InputError(f"{ds.root}: views {view1!r} and {view2!r} share one camera centre (zero baseline): "
                          "no relative translation and no depth to estimate")
     return t
 
 
-def view_points(ds, view: str, pool: int) -> ViewsTruth:
+def view_points(ds, view: str, pool: int, obj: str | None = None) -> ViewsTruth:
     """The truth of one view (module docstring)."""
     _, X = ds.points_at_pixels(ds.check_view(view), max_points=pool, seed=0)
     if len(X) == 0:
         raise InputError(f"{ds.root}: view {view!r} has no valid truth pixel")
-    return _build(ds, (view,), np.asarray(X, np.float64), "truth points at the view's valid pixel centres "
-                  "(seeded sample)")
+    how = "truth points at the view's valid pixel centres (seeded sample)"
+    return _build(ds, (view,), *_on_object(ds, view, np.asarray(X, np.float64), obj, how))
 
 
 def plane_of(X_cam: np.ndarray, rel_tol: float) -> tuple[np.ndarray, float, float]:
@@ -88,6 +105,7 @@ def plane_of(X_cam: np.ndarray, rel_tol: float) -> tuple[np.ndarray, float, floa
     res = float(np.max(np.abs((X_cam - c) @ n)))
     extent = float(np.max(np.linalg.norm(X_cam - c, axis=1)))
     if len(X_cam) < 4 or res > rel_tol * extent:
-        raise InputError(f"sweep --kind h: the pair's truth points are not coplanar (max {res:.3g} m off their best "
-                         f"plane, extent {extent:.3g} m): a homography sweep needs a planar scene")
+        raise InputError(f"sweep --kind h: the pair's truth points are not coplanar (max {res:.3g} m off their "
+                         f"best plane, extent {extent:.3g} m): a homography sweep needs a planar scene, or "
+                         "--object NAME of a planar object")
     return n, float(n @ c), res

@@ -156,11 +156,13 @@ def _cli(dataset, out, kind, *extra) -> int:
 def test_cli_sweep_each_kind(kind, views, plane_dataset, tmp_path, capsys):
     """On the analytic plane dataset (free_000: an OpenCV camera with distortion, swept in its
     undistorted pixels); the tables and the report follow the kind's error."""
-    code = _cli(plane_dataset[0], tmp_path / "o", kind, "--views", *views, "--markdown", str(tmp_path / "t.md"))
+    extra = ["--object", "plane"] if kind == "h" else []  # (every point is on it)
+    code = _cli(plane_dataset[0], tmp_path / "o", kind, "--views", *views, "--markdown", str(tmp_path / "t.md"), *extra)
     assert code == 0, capsys.readouterr().err
     doc = json.loads((tmp_path / "o" / "sweep.json").read_bytes())
     k = KINDS[kind]
     assert doc["inputs"]["kind"] == kind and doc["inputs"]["views"] == views
+    assert doc["inputs"]["truth"]["points"].endswith("on object 'plane'") == (kind == "h")
     assert doc["results"]["error"]["unit"] == k.unit and doc["results"]["config"]["breakdown"] == k.default_breakdown
     assert {c["method"] for c in doc["results"]["cells"]} == set(k.default_methods())
     assert len(doc["results"]["cells"]) == 2 * len(k.default_methods())
@@ -175,7 +177,9 @@ def test_cli_sweep_kind_bad_input_exits_2(plane_dataset, tmp_path, capsys):
                        "F methods only"),
                       (("e", "--views", "left_000", "right_000", "--methods", "opencv-f-8point"),
                        "unknown method 'opencv-f-8point'"),
-                      (("triangulation", "--views", "left_000", "left_000"), "must differ")]:
+                      (("triangulation", "--views", "left_000", "left_000"), "must differ"),
+                      (("h", "--views", "left_000", "right_000", "--object", "wall"), "spec.objects"),
+                      (("f", "--views", "left_000", "right_000", "--object", "plane"), "not for --kind f")]:
         code = _cli(root, tmp_path / "o", *args)
         err = capsys.readouterr().err
         assert code == 2 and msg in err and err.count("\n") == 1, (args, err)
