@@ -18,7 +18,7 @@ F_ERROR = {"kind": "f", "label": "fundamental matrix", "measure": "distance of t
            "median_key": "median_trial_epi_px"}
 
 
-def _error(results: dict) -> dict:
+def results_error(results: dict) -> dict:
     return results.get("error", F_ERROR)
 
 
@@ -33,7 +33,7 @@ def _px(v) -> str:
     return f"{v:.3g}"
 
 
-def _entry(c, err) -> str:
+def cell_entry(c, err) -> str:
     mean = _px(c[err["mean_key"]])
     return mean if mean == "fail" else f"{mean} ± {_px(c[err['std_key']])}"
 
@@ -42,7 +42,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str
     """Rows: methods; columns: the swept sigmas at ``outlier_fraction`` (or the fractions at
     ``sigma_px``); each entry ``mean ± std`` of the kind's error (F: px of the distances to the
     epipolar lines), or the cell's ``key`` (e.g. ``pose_err_deg``) when given."""
-    cells, err = results["cells"], _error(results)
+    cells, err = results["cells"], results_error(results)
     if outlier_fraction is not None:
         cells = [c for c in cells if c["outlier_fraction"] == outlier_fraction]
         axis, head = "sigma_px", "sigma {} px"
@@ -58,7 +58,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str
         fam = next(c["family"] for c in cells if c["method"] == m)
         vals = [by.get((m, v)) for v in cols]
         lines.append(f"| `{m}` | {fam} | " + " | ".join(
-            "" if c is None else (_entry(c, err) if key is None else _px(c[key])) for c in vals) + " |")
+            "" if c is None else (cell_entry(c, err) if key is None else _px(c[key])) for c in vals) + " |")
     return "\n".join(lines)
 
 
@@ -85,7 +85,7 @@ def breakdown_table(results: dict) -> str:
 def markdown(results: dict) -> str:
     """Every table of a sweep: per outlier fraction (error vs noise), per sigma (error vs outliers),
     and the breakdown points."""
-    cfg, err = results["config"], _error(results)
+    cfg, err = results["config"], results_error(results)
     parts = [f"Breakdown: the smallest outlier fraction whose median trial error exceeds {_threshold(cfg)} "
              f"{err['unit']}.", "", breakdown_table(results), ""]
     what = ("the truth points' distances to the epipolar lines" if err["kind"] == "f"
@@ -103,7 +103,7 @@ def markdown(results: dict) -> str:
 def figures(results: dict) -> list[Figure]:
     """Error against noise (no outliers), and against the outlier fraction at each sigma, one panel per
     method family."""
-    cells, cfg, err = results["cells"], results["config"], _error(results)
+    cells, cfg, err = results["cells"], results["config"], results_error(results)
     fam = {c["method"]: c["family"] for c in cells}
     unit = err["unit"]
     what = "distance to epipolar line" if err["kind"] == "f" else err["measure"].split(",")[0].split(":")[0]
