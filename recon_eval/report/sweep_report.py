@@ -19,6 +19,7 @@ F_ERROR = {"kind": "f", "label": "fundamental matrix", "measure": "distance of t
 
 
 def results_error(results: dict) -> dict:
+    """What a sweep's cells report (its ``error``; F's for a document from before the kinds)."""
     return results.get("error", F_ERROR)
 
 
@@ -34,6 +35,7 @@ def _px(v) -> str:
 
 
 def cell_entry(c, err) -> str:
+    """``mean ± std`` of a cell's error (``err``: :func:`results_error`), or "fail"."""
     mean = _px(c[err["mean_key"]])
     return mean if mean == "fail" else f"{mean} ± {_px(c[err['std_key']])}"
 

@@ -62,7 +62,9 @@ def score(pose, trial, truth) -> dict:
     r = pnp_errors(R, t, p.R, p.t, cam=cam, points_world=truth.X[trial.rows][keep], pixels=trial.t[keep])
     rep = np.inf if r.reprojection is None else r.reprojection.rms_px
     return {"reproj_px": rep, "rot_err_deg": r.rot_err_deg, "trans_err_m": r.trans_abs_err_m,
-            "failed": r.failed or not np.isfinite(rep), "failure_reason": "no pose" if r.failed else None}
+            "failed": r.failed or not np.isfinite(rep),
+            "failure_reason": "no pose" if r.failed else (None if np.isfinite(rep) else "a truth point does not "
+                                                          "project at the estimated pose (behind the camera)")}
 
 
 def _draw(truth, n, sigma, frac, seed, cell, trial):
