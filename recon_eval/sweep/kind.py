@@ -20,7 +20,6 @@ class SweepKind:
     default_breakdown: float  # the median-trial error (unit) above which a method has broken down
     n_views: int  # views the truth takes (--views)
     truth: Callable  # (DatasetTruth, views tuple, pool, object name or None) -> the kind's truth
-    views_of: Callable  # (truth) -> the views it was built from (for the report)
     draw: Callable  # (truth, n, sigma_px, outlier_fraction, seed, cell, trial) -> a trial
     fit: Callable  # (SweepMethod, trial, truth, method seed, workdir) -> estimate or None
     score: Callable  # (estimate or None, trial, truth) -> dict of scores (error_key, failed, ...)

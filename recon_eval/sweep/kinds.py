@@ -28,7 +28,7 @@ def _f_draw(truth, n, sigma, frac, seed, cell, trial):
 F_KIND = SweepKind(
     "f", "fundamental matrix", "fmatrix-sweep", "mean and std of the distances of the noise-free truth points of each "
     "trial's inliers to the estimated epipolar lines, both images (docs/fmatrix_survey.md)", "epi_mean_px", "px",
-    ("epi_mean_px", "epi_std_px", "median_trial_epi_px"), 8, 2.0, 2, _f_truth, lambda truth: None, _f_draw,
+    ("epi_mean_px", "epi_std_px", "median_trial_epi_px"), 8, 2.0, 2, _f_truth, _f_draw,
     lambda m, trial, truth, seed, wd: m.fit(trial.x1, trial.x2, seed, wd), score_trial, summarise_cell, resolve,
     all_survey, lambda truth: truth.notes)
 

@@ -59,10 +59,6 @@ def _fit(m, trial, truth, seed, workdir):
     return m.fit(trial, truth, seed, workdir)
 
 
-def _views(truth):
-    return list(truth.views)
-
-
 def _notes(extra: dict):
     return lambda truth: {**truth.notes, **extra}
 
@@ -164,7 +160,7 @@ def _with_baseline(ds, views, pool, obj=None):
 def _kind(name, label, stream, measure, key, unit, extras, min_inl, breakdown, truth, score, methods, notes):
     return SweepKind(
         name, label, stream, measure, key, unit, (f"mean_{key}", f"std_{key}", f"median_trial_{key}"), min_inl,
-        breakdown, 2, truth, _views, _pair_draw(stream), _fit, score,
+        breakdown, 2, truth, _pair_draw(stream), _fit, score,
         lambda trials, b: summarise_scores(trials, b, key, extras), builtin_resolver(name, methods),
         lambda: list(methods), _notes(notes))
 

@@ -75,7 +75,7 @@ KEY = "reproj_px"
 PNP_KIND = SweepKind(
     "pnp", "absolute pose (PnP)", STREAM, "reprojection RMS of the inlier truth points at the estimated pose "
     "against their noise-free pixels, px", KEY, "px", (f"mean_{KEY}", f"std_{KEY}", f"median_trial_{KEY}"), 6, 2.0, 1,
-    lambda ds, views, pool, obj=None: view_points(ds, views[0], pool, obj), lambda truth: list(truth.views), _draw,
+    lambda ds, views, pool, obj=None: view_points(ds, views[0], pool, obj), _draw,
     lambda m, trial, truth, seed, wd: m.fit(trial, truth, seed, wd), score,
     lambda trials, b: summarise_scores(trials, b, KEY, ("rot_err_deg", "trans_err_m")),
     builtin_resolver("pnp", METHODS), lambda: list(METHODS), lambda truth: dict(truth.notes))
