@@ -170,6 +170,20 @@ def test_external_disparity_is_scored_as_the_builtin(tmp_path):
     assert res.notes["cam_l"]["failed"] == "exit status 1" and res.metrics["invalid_noc_pct"] == 100.0
 
 
+def test_external_disparity_of_the_wrong_sign_is_hinted(tmp_path, capsys):
+    """The command writes the negated truth: ~100 % bad, and a warning naming the method and frame."""
+    frame = _Frame(tmp_path)
+    np.save(tmp_path / "neg.npy", -frame.disp)
+    tool = tmp_path / "neg.py"
+    tool.write_text("import sys, numpy as np\nfrom scenegen.dataset.codecs import write_pfm\n"
+                    f"write_pfm(sys.argv[1], np.load({str(tmp_path / 'neg.npy')!r}))\n")
+    m = external_method("neg-stereo", "disparity", f"{{python}} {tool} {{out}}")
+    res = external.disparity(frame, tmp_path / "run", dict(m.options))
+    assert res.metrics["bad_2_0_noc_pct"] > 99.0
+    assert len(res.warnings) == 1 and res.warnings[0].startswith("cam_l (non-occluded): ")
+    assert "is its sign reversed?" in res.warnings[0]
+
+
 # --- on a rendered scene ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def wide(tmp_path_factory):

@@ -1,0 +1,120 @@
+"""Kinds of a user's command (:mod:`recon_eval.runners.external`, ``KINDS``) scored as the built-in
+keypoint and absolute-pose methods (docs/ci.md, "Your own estimator"):
+
+* ``features``: once per dataset: ``{images}`` a folder of ``<view>.png`` and ``{pairs}`` a text
+  file of the cross-view pairs (``view_i view_j`` per line) -> ``{out}`` a folder in recon_eval's
+  feature format (``keypoints/<view>.txt``, ``matches/<view_i>__<view_j>.txt``, docs/features.md);
+  scored as ``opencv-features-*`` and ``recon-eval features``.
+* ``pnp``: per view (OpenCV / pinhole cameras): ``{image}``, ``{points}`` (an (N, 5) ``.npy`` of
+  ``u v X Y Z``: the ``points`` input of the built-in PnP methods, noisy truth pixels with 30 %
+  outliers, world metres) and ``{k}`` / ``{dist}`` (3x3 text, OpenCV's distortion row) ->
+  ``{out}`` cam_from_world as 3x4 text ``[R | t]``; scored as the built-in PnP methods' ``points``
+  (``points.median_rot_err_deg``, ...).
+"""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from recon_eval.errors import InputError, NotApplicable
+from recon_eval.metrics.pnp import pnp_errors
+from recon_eval.readers.features import read_feature_files
+from recon_eval.readers.npy import read_npy
+from recon_eval.runners import pnp as pnp_runner
+from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from recon_eval.runners.external import failed_output, invoke
+from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
+from scenegen.dataset.layout import check_view_name
+from scenegen.geometry.camera import camera_model
+
+
+def features(ds, out_dir, options) -> RunOutput:
+    """The ``features`` kind (module docstring)."""
+    pairs = list(crossview_pairs(ds))
+    views = list(dict.fromkeys(v for p in pairs for v in p))
+    images, result = out_path(out_dir, "images/x").parent, Path(out_dir) / "features"
+    shutil.rmtree(images, ignore_errors=True)
+    shutil.rmtree(result, ignore_errors=True)
+    images.mkdir(parents=True)
+    result.mkdir()
+    for v in views:
+        shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+    pairs_txt = out_path(out_dir, "pairs.txt")
+    pairs_txt.write_text("".join(f"{i} {j}\n" for i, j in pairs))
+    out = RunOutput()
+    why = invoke(options, {"images": str(images.resolve()), "pairs": str(pairs_txt.resolve()),
+                           "out": str(result.resolve()), "dataset": str(Path(ds.root).resolve())},
+                 Path(out_dir) / "logs", "features", out)
+    shutil.rmtree(images, ignore_errors=True)  # the copies of the images
+    files = None
+    if why is None:
+        try:
+            files = read_feature_files(result, views, pairs)
+        except InputError as exc:  # unreadable files are the method's failure: scored with no keypoints
+            failed_output(out, "features", str(exc))
+    none = {v: np.zeros((0, 2)) for v in views}
+    ev = evaluate_features(ds, none if files is None else files.keypoints, {} if files is None else files.matches,
+                           pairs, DEFAULT_EPS_PX)
+    out.results = results_dict(ev, files)
+    out.metrics = headline_metrics(ev)
+    if files is not None:
+        out.raw_files += sorted(str(f.relative_to(out_dir)) for f in result.rglob("*") if f.is_file())
+    return out
+
+
+def pnp(ds, out_dir, options) -> RunOutput:
+    """The ``pnp`` kind (module docstring)."""
+    rng = np.random.default_rng(pnp_runner.SEED)  # the built-in methods' draws, view by view
+    out, errs = RunOutput(), {"points": []}
+    root = str(Path(ds.root).resolve())
+    for v in ds.views:
+        cam, pose = ds.camera(v)
+        if camera_model(cam.model).opencv_fisheye:  # as the built-in methods: OpenCV's perspective models
+            continue
+        name = check_view_name(v)
+        uv, X = pnp_runner.noisy_points(ds, v, cam, rng)
+        d = Path(out_dir) / name
+        d.mkdir(parents=True, exist_ok=True)
+        K, D = cam.to_opencv()
+        paths = {"points": d / "points.npy", "k": d / "K.txt", "dist": d / "dist.txt", "out": d / "pose.txt"}
+        np.save(paths["points"], np.concatenate([uv, X], axis=1))
+        np.savetxt(paths["k"], K, fmt="%.17g")
+        np.savetxt(paths["dist"], np.reshape(D, (1, -1)), fmt="%.17g")
+        paths["out"].unlink(missing_ok=True)
+        values = {k: str(p.resolve()) for k, p in paths.items()}
+        values.update(image=str(ds.image_path(v).resolve()), view=name, dataset=root)
+        why = invoke(options, values, d, name, out)
+        Rt = None
+        if why is None and not paths["out"].is_file():
+            failed_output(out, name, "wrote no pose.txt")
+        elif why is None:
+            try:
+                Rt = read_npy_or_text(paths["out"])
+                out.raw_files.append(f"{name}/pose.txt")
+            except InputError as exc:
+                failed_output(out, name, str(exc))
+        if Rt is None:
+            r = pnp_errors(np.full((3, 3), np.nan), np.full(3, np.nan), pose.R, pose.t)
+        else:
+            r = pnp_errors(Rt[:, :3], Rt[:, 3], pose.R, pose.t, cam=cam, points_world=X, pixels=uv)
+        out.results[f"points.{v}"] = r
+        errs["points"].append((r.rot_err_deg, r.trans_abs_err_m, r.failed, float("inf")))
+    if not errs["points"]:
+        raise NotApplicable(f"{ds.root}: no view with an OpenCV/pinhole camera")
+    pnp_runner.headline(errs, out)
+    return out
+
+
+def read_npy_or_text(path: Path) -> np.ndarray:
+    """A 3x4 ``[R | t]`` from a text file (whitespace between numbers) or a ``.npy``."""
+    if path.suffix == ".npy":
+        return read_npy(path, (3, 4))
+    try:
+        a = np.loadtxt(path, ndmin=2)
+    except ValueError as exc:
+        raise InputError(f"{path}: expected 3 rows of 4 numbers ([R | t], cam_from_world): {exc}") from None
+    if a.shape != (3, 4):
+        raise InputError(f"{path}: expected 3 rows of 4 numbers ([R | t], cam_from_world), got shape {a.shape}")
+    return a
