@@ -4,6 +4,8 @@ or ``--command``) and the same estimate scored by hand with the command's ``--js
 in :mod:`recon_eval.tasks.fmatrix_pair` (:func:`~recon_eval.tasks.fmatrix_pair.headline`)."""
 from __future__ import annotations
 
+import numpy as np
+
 #: Optical flow (:class:`recon_eval.metrics.flow.FlowResult` field -> headline name).
 FLOW = {"epe_all_px": "epe_all_px", "epe_noc_px": "epe_noc_px", "epe_occ_px": "epe_occ_px",
         "fl_all_all_pct": "fl_all_all_pct", "s0_10_px": "s0_10_px"}
@@ -21,3 +23,26 @@ def depth_headline(r, alignment: str) -> dict:
     """The headline of a :class:`~recon_eval.metrics.depth.DepthResult` under ``alignment``."""
     pre = "" if alignment == "none" else f"{alignment}."
     return {pre + name: getattr(r, field) for field, name in DEPTH.items()}
+
+
+def calibration_headline(intrinsics, projection_diff, held_out=None, prefix: str = "") -> dict:
+    """The headline of an estimated calibration: its intrinsics errors
+    (:class:`~recon_eval.metrics.calibration.IntrinsicsErrors`), projection difference and
+    held-out reprojection RMS (None: not measured), ``prefix`` (a camera's name) in front."""
+    m = {"fx_rel_err": intrinsics.fx_rel_err, "fy_rel_err": intrinsics.fy_rel_err,
+         "cx_abs_err_px": intrinsics.cx_abs_err_px, "cy_abs_err_px": intrinsics.cy_abs_err_px,
+         "proj_diff_rms_px": projection_diff.rms_px, "proj_diff_max_px": projection_diff.max_px}
+    if held_out is not None:
+        m["held_out_reproj_rms_px"] = held_out.rms_px
+    return {prefix + k: v for k, v in m.items()}
+
+
+def poses_headline(ape, alignment: str) -> dict:
+    """The headline of camera poses against the truth (an :class:`~recon_eval.metrics.poses.ApeResult`):
+    as the SfM runs name them after their Sim(3) alignment (registration ratio, max and median
+    rotation error; unregistered cameras inf), ``<alignment>.`` in front for another alignment."""
+    rot = [float(x) for x in ape.rot_err_deg]
+    pre = "" if alignment == "sim3" else f"{alignment}."
+    return {pre + "registration_ratio": ape.registration_ratio,
+            pre + "max_rot_err_deg": max(rot) if rot else float("inf"),
+            pre + "median_rot_err_deg": float(np.median(rot)) if rot else float("inf")}

@@ -296,6 +296,10 @@ def test_external_sfm_model_is_scored_as_pycolmap(plane_dataset, tmp_path):
     met = doc["metrics"]
     assert met["registration_ratio"] == 1.0 and met["max_rot_err_deg"] < 1e-6 and met["n_points3d"] == 4
     assert met["cloud_precision_at_1cm"] == 0.75
+    # the same model scored by hand: the same numbers under the same names (one gate file for both)
+    assert main(["poses", str(tmp_path / "run" / "model"), str(root), "--json", str(tmp_path / "p.json"), "-q"]) == 0
+    by_hand = json.loads((tmp_path / "p.json").read_text())["metrics"]
+    assert by_hand == {k: met[k] for k in ("registration_ratio", "max_rot_err_deg", "median_rot_err_deg")}
     assert doc["inputs"]["raw_files"] == ["model/cameras.txt", "model/images.txt", "model/points3D.txt"]
     _colmap_text_model(tmp_path / "two", cams, ["left_000", "right_000"], pts)
     tool.write_text(f"import shutil, sys\nshutil.copytree({str(tmp_path / 'two')!r}, sys.argv[2], dirs_exist_ok=True)\n")
@@ -327,6 +331,11 @@ def test_external_calibration_is_scored_as_the_builtin(plane_dataset, tmp_path):
     assert met["left.fx_rel_err"] == 0 and met["right.proj_diff_rms_px"] < 1e-9
     assert met["free.fx_rel_err"] == pytest.approx(0.5 / cams["free_000"][0].fx, abs=1e-15)
     assert "free.calib_rms_px" not in met and doc["inputs"]["task"] == "calibration"
+    # the same file scored by hand: the run's names without the camera prefix, the same numbers
+    assert main(["calibration", str(tmp_path / "run" / "calibration_free.yaml"), str(root), "--view", "free_000",
+                 "--json", str(tmp_path / "c.json"), "-q"]) == 0
+    by_hand = json.loads((tmp_path / "c.json").read_text())["metrics"]
+    assert by_hand == {k.removeprefix("free."): v for k, v in met.items() if k.startswith("free.")}
     assert sorted(doc["inputs"]["raw_files"]) == ["calibration_free.yaml", "calibration_left.yaml",
                                                    "calibration_right.yaml"]
 
