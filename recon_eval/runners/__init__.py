@@ -67,7 +67,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration",
          ("external_more", "flow"): "optical flow", ("external_more", "depth"): "depth maps",
          ("external_more", "essential"): "essential matrix", ("external_views", "features"): "keypoints and matches",
-         ("external_views", "pnp"): "absolute pose (PnP)"}
+         ("external_views", "pnp"): "absolute pose (PnP)", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
+         ("external_sequence", "trajectory"): "camera trajectory"}
 
 
 def _m(name, module, function, description, **options):

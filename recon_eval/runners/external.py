@@ -100,6 +100,14 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "per view: {points} is an (N, 5) .npy of u v X Y Z (noisy truth pixels with 30 % outliers, world metres), "
          "{k} and {dist} the camera's K (3x3) and OpenCV distortion (text); write cam_from_world [R | t] (3x4 text) "
          "to {out}; scored as the built-in PnP methods' points input", "external_views"),
+    Kind("tracks", "tracks", ("images", "queries", "out"),
+         "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
+         "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "
+         "opencv-lk-tapvid", "external_sequence"),
+    Kind("trajectory", "trajectory", ("images", "times", "camera", "k", "dist", "out"),
+         "per camera stream of 3+ frames: {images} its frames in time order, {times} lines 'timestamp image', {k} "
+         "{dist} its K and distortion (text); write a TUM trajectory (timestamp tx ty tz qx qy qz qw, world_from_cam) "
+         "to {out}; APE (Sim(3)) and RPE as recon-eval poses", "external_sequence"),
 ]}
 ALWAYS = ("python", "dataset")
 #: ``declared_at`` of a method made by ``recon-eval run --command``, and the option of each field

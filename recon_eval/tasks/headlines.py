@@ -46,3 +46,17 @@ def poses_headline(ape, alignment: str) -> dict:
     return {pre + "registration_ratio": ape.registration_ratio,
             pre + "max_rot_err_deg": max(rot) if rot else float("inf"),
             pre + "median_rot_err_deg": float(np.median(rot)) if rot else float("inf")}
+
+
+def trajectory_headline(ape, rpe, alignment: str) -> dict:
+    """The headline of a camera trajectory: :func:`poses_headline`, then evo's APE and RPE
+    translation RMSE (finite entries; unregistered cameras count in the ratio and the max)."""
+    pre = "" if alignment == "sim3" else f"{alignment}."
+    return {**poses_headline(ape, alignment), pre + "ape_trans_rmse_m": ape.trans_stats_m.rmse,
+            pre + "rpe_trans_rmse_m": rpe.trans_stats_m.rmse}
+
+
+def tracks_headline(res: dict) -> dict:
+    """The headline of point tracks (TAP-Vid's mean over the streams, ``score_streams``' result)."""
+    mean = res["mean_over_streams"]
+    return {k: mean[k] for k in ("average_jaccard", "average_pts_within", "occlusion_accuracy")}
