@@ -148,4 +148,5 @@ def calibration_metrics(a, res) -> dict:
     return calibration_headline(res["intrinsics"], res["projection_diff"], res.get("reprojection_held_out"))
 
 
-COMMANDS = {"calibration": scored(calibration_arguments, score_calibration, calibration_metrics), "pnp": scored(pnp_arguments, score_pnp)}
+COMMANDS = {"calibration": scored(calibration_arguments, score_calibration, calibration_metrics),
+            "pnp": scored(pnp_arguments, score_pnp)}

@@ -92,6 +92,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "per cross-view pair: read {images} and the intrinsics {k1} {k2} (3x3 text), write E (3x3 text, "
          "x2n^T E x1n = 0 on normalised undistorted coordinates) to {out}; the pose recovered on the truth "
          "correspondences is scored as the built-in E methods", "external_more"),
+    Kind("homography", "homography", ("images", "image1", "image2", "view1", "view2", "plane", "mask", "out"),
+         "per cross-view pair and plane with a truth homography: read {images}, {plane} (its name) and {mask} (PNG of "
+         "image 1, 255 on the plane); write H (3x3 text, x2 ~ H x1, undistorted pixels) to {out}; the mean corner "
+         "error as the built-in H methods", "external_more"),
     Kind("features", "features", ("images", "pairs", "out"),
          "once: {images} is a folder of <view>.png, {pairs} a text file of the cross-view pairs (view_i view_j per "
          "line); write keypoints/<view>.txt and matches/<view_i>__<view_j>.txt (docs/features.md) into the folder "

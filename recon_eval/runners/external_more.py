@@ -14,6 +14,11 @@ command of its task (docs/ci.md, "Your own estimator").
   x2n^T E x1n = 0 for normalised undistorted coordinates xn = K^-1 x); its relative pose is
   recovered on the truth correspondences (``cv2.recoverPose``) and scored as the built-in E methods.
 
+* ``homography``: per cross-view pair and planar object with a truth homography: ``{images}``,
+  ``{plane}`` (its name) and ``{mask}`` (a PNG of image 1, 255 on the plane's pixels, from the
+  object-id truth) -> ``{out}`` H (3x3 text, x2 ~ H x1 in undistorted pixels); the mean corner
+  error against the truth H, as the built-in H methods (``<plane>.mace_px``).
+
 A failed invocation or an unreadable output is a failed estimate of that item (NaN: the metrics'
 own failure), never dropped.
 """
@@ -25,7 +30,7 @@ import numpy as np
 
 from recon_eval.errors import InputError, NotApplicable
 from recon_eval.metrics.depth import eigen_depth_metrics
-from recon_eval.metrics.epipolar import pose_error_from_fundamental
+from recon_eval.metrics.epipolar import homography_mace, pose_error_from_fundamental
 from recon_eval.metrics.flow import flow_metrics
 from recon_eval.readers.flow import read_flow
 from recon_eval.readers.matrix import read_matrix3
@@ -35,7 +40,9 @@ from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.external import failed_output, invoke
 from recon_eval.tasks.fmatrix_pair import pair_truth
 from recon_eval.tasks.headlines import depth_headline, flow_headline
-from scenegen.dataset.layout import check_view_name
+from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.files import atomic_write_bytes
+from scenegen.dataset.layout import check_name, check_view_name
 
 #: The alignments a depth method is scored under (``recon-eval depth --alignment``).
 DEPTH_ALIGNMENTS = ("none", "median")
@@ -149,4 +156,41 @@ def essential(ds, out_dir, options) -> RunOutput:
         out.metrics.update({pre + "pose_err_deg": pe.pose_err_deg, pre + "rot_err_deg": pe.rot_err_deg})
     if not out.results:
         raise NotApplicable(f"{ds.root}: the cross-view pairs are all zero-baseline: no essential matrix to estimate")
+    return out
+
+
+def homography(ds, out_dir, options) -> RunOutput:
+    """The ``homography`` kind (module docstring)."""
+    pairs = crossview_pairs(ds)
+    out = RunOutput()
+    root = str(Path(ds.root).resolve())
+    for i, j in pairs:
+        planes = ds.twoview(i, j).homographies
+        ci, _ = ds.camera(i)
+        for plane, H_gt in planes.items():
+            key = f"{check_view_name(i)}__{check_view_name(j)}/{check_name('plane', plane)}"
+            d = Path(out_dir) / key
+            d.mkdir(parents=True, exist_ok=True)
+            mask, hpath = d / "mask.png", d / "H.txt"
+            atomic_write_bytes(mask, encode_png(np.where(ds.object_ids(i) == ds.object_id(plane), 255, 0)
+                                                .astype(np.uint8)))
+            hpath.unlink(missing_ok=True)
+            images = [str(ds.image_path(i).resolve()), str(ds.image_path(j).resolve())]
+            values = {"images": images, "image1": images[0], "image2": images[1], "view1": i, "view2": j,
+                      "plane": plane, "mask": str(mask.resolve()), "out": str(hpath.resolve()), "dataset": root}
+            why = invoke(options, values, d, key, out)
+            H = None if why else _read(hpath, out, key, lambda p: read_matrix3(p, key="H"))
+            if H is None:
+                H = np.full((3, 3), np.nan)
+            else:
+                out.raw_files.append(f"{key}/H.txt")
+            r = homography_mace(H, H_gt, ci.width, ci.height)
+            if r.failed and not why and out.notes.get(key, {}).get("failed") is None:
+                out.warnings.append(f"{key}: the estimated H is {r.failure_reason}: scored as a failed estimate "
+                                    f"(mace_px inf)")
+            out.results[f"{i}__{j}.{plane}.homography"] = r
+            pre = "" if len(pairs) == 1 else f"{i}__{j}."
+            out.metrics[f"{pre}{plane}.mace_px"] = r.mace_px
+    if not out.results:
+        raise NotApplicable(f"{ds.root}: no cross-view pair has a planar object with a truth homography")
     return out

@@ -225,7 +225,7 @@ def homography(ds, out_dir, options) -> RunOutput:
                 out.raw_files.append(f"{i}__{j}/{kind}_{plane}_H.txt")
                 r = homography_mace(np.loadtxt(hp), H_gt, ci.width, ci.height)
                 out.results[f"{key}.homography"] = r
-                pre = f"{kind}.{plane}." if len(pairs) == 1 else f"{key}."
+                pre = headline_prefix(i, j, kind, len(pairs)) + f"{plane}."
                 out.metrics[pre + "mace_px"] = r.mace_px
                 out.notes[f"{key}.matches_on_plane"] = int(on.sum())
     if not out.raw_files:

@@ -369,3 +369,19 @@ def test_leaderboard_with_declared_methods_and_gates(plane_dataset, tmp_path, ca
     (line,) = out.splitlines()
     assert line.startswith("FAIL n_points3d = 1, threshold >= 100"), out
     assert (tmp_path / "q" / "leaderboard.html").is_file()
+
+
+@pytest.mark.render
+def test_external_homography_kind_on_the_planes(wide, tmp_path):
+    """The truth H of each plane: MACE 0 under the built-in H methods' names; transposed: large."""
+    est = ROOT / "tests" / "recon_eval" / "runners" / "estimators" / "true_homography.py"
+    cmd = f"{{python}} {est} {{dataset}} {{view1}} {{view2}} {{plane}} {{out}}"
+    doc = run_method("my-h", wide, tmp_path / "h", declared={"my-h": external_method("my-h", "homography", cmd)})
+    ref = run_method("opencv-h-usac-magsac", wide, tmp_path / "ref")
+    planes = {k for k in ref["metrics"] if not k.startswith("synthetic.")}  # the estimate from the images
+    assert set(doc["metrics"]) >= planes and doc["inputs"]["task"] == ref["inputs"]["task"] == "homography"
+    assert all(v < 1e-6 for v in doc["metrics"].values())
+    bad = run_method("my-h-t", wide, tmp_path / "t",
+                     declared={"my-h-t": external_method("my-h-t", "homography", cmd + " --transpose")})
+    assert all(v > 10 for v in bad["metrics"].values())
+
