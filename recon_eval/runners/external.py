@@ -104,6 +104,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "per view: {points} is an (N, 5) .npy of u v X Y Z (noisy truth pixels with 30 % outliers, world metres), "
          "{k} and {dist} the camera's K (3x3) and OpenCV distortion (text); write cam_from_world [R | t] (3x4 text) "
          "to {out}; scored as the built-in PnP methods' points input", "external_views"),
+    Kind("normals", "normals", ("images", "lights", "intensities", "mask", "out"),
+         "per photometric stereo set under distant lights: {images} its images in order, {lights} light_directions.txt "
+         "and {intensities} light_intensities.txt (DiLiGenT's axes), {mask} (PNG, 255 on the objects); write an "
+         "(H, W, 3) .npy normal map in DiLiGenT's axes to {out}; DiLiGenT's errors as woodham-ps", "external_views"),
     Kind("tracks", "tracks", ("images", "queries", "out"),
          "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
          "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "

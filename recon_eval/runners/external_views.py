@@ -10,6 +10,12 @@ keypoint and absolute-pose methods (docs/ci.md, "Your own estimator"):
   outliers, world metres) and ``{k}`` / ``{dist}`` (3x3 text, OpenCV's distortion row) ->
   ``{out}`` cam_from_world as 3x4 text ``[R | t]``; scored as the built-in PnP methods' ``points``
   (``points.median_rot_err_deg``, ...).
+* ``normals``: per photometric stereo set under distant lights: ``{images}`` its images in order,
+  ``{lights}`` (``light_directions.txt``: one row ``x y z`` per image, DiLiGenT's axes: x right,
+  y up, z toward the camera), ``{intensities}`` (``light_intensities.txt``: ``r g b`` per image)
+  and ``{mask}`` (PNG, 255 on the objects) -> ``{out}`` an (H, W, 3) ``.npy`` normal map in
+  DiLiGenT's axes; DiLiGenT's angular errors over all objects and per object, as ``woodham-ps``
+  and ``recon-eval normals`` (``all.mean_ae_deg``, ``<object>.median_ae_deg``, ``.within_10deg``).
 """
 from __future__ import annotations
 
@@ -19,15 +25,21 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError, NotApplicable
+from recon_eval.metrics.normals import normal_metrics
 from recon_eval.metrics.pnp import pnp_errors
 from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.npy import read_npy
+from recon_eval.readers.photometric import photometric_sets
 from recon_eval.runners import pnp as pnp_runner
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.external import failed_output, invoke
 from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
+from recon_eval.tasks.headlines import normals_headline
+from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.files import atomic_write_bytes
 from scenegen.dataset.layout import check_view_name
 from scenegen.geometry.camera import camera_model
+from scenegen.geometry.conventions import DILIGENT_FROM_OPENCV_CAM
 
 
 def features(ds, out_dir, options) -> RunOutput:
@@ -118,3 +130,40 @@ def read_npy_or_text(path: Path) -> np.ndarray:
     if a.shape != (3, 4):
         raise InputError(f"{path}: expected 3 rows of 4 numbers ([R | t], cam_from_world), got shape {a.shape}")
     return a
+
+
+def normals(ds, out_dir, options) -> RunOutput:
+    """The ``normals`` kind (module docstring)."""
+    sets = [s for s in photometric_sets(ds.root) if np.isnan(s.positions_cam).all()]
+    if not sets:
+        raise NotApplicable(f"{ds.root}: no photometric stereo set under distant (directional) lights")
+    out = RunOutput()
+    root = str(Path(ds.root).resolve())
+    for k, s in enumerate(sets):
+        name = f"set{k}" if len(sets) > 1 else "ps"
+        d = Path(out_dir) / name
+        d.mkdir(parents=True, exist_ok=True)
+        paths = {"lights": d / "light_directions.txt", "intensities": d / "light_intensities.txt",
+                 "mask": d / "mask.png", "out": d / "normals.npy"}
+        np.savetxt(paths["lights"], s.directions_cam @ DILIGENT_FROM_OPENCV_CAM.T, fmt="%.17g")
+        np.savetxt(paths["intensities"], s.intensities, fmt="%.17g")
+        atomic_write_bytes(paths["mask"], encode_png(np.where(s.object_id > 0, 255, 0).astype(np.uint8)))
+        paths["out"].unlink(missing_ok=True)
+        values = {key: str(p.resolve()) for key, p in paths.items()}
+        values.update(images=[str(ds.image_path(v).resolve()) for v in s.views], dataset=root)
+        est = None
+        if invoke(options, values, d, name, out) is None:
+            try:
+                est = read_npy(paths["out"], s.normals_cam.shape)
+                out.raw_files.append(f"{name}/normals.npy")
+            except InputError as exc:  # the method's failure: no normals
+                failed_output(out, name, str(exc))
+        n_cv = np.full(s.normals_cam.shape, np.nan) if est is None else est @ DILIGENT_FROM_OPENCV_CAM.T
+        pre = f"{name}." if len(sets) > 1 else ""
+        groups = {"all": s.object_id > 0, **{obj: s.object_id == oid for obj, oid in s.objects.items()}}
+        for group, m in groups.items():
+            if m.any():
+                r = normal_metrics(s.normals_cam, n_cv, m)
+                out.results[f"{pre}{group}.normals"] = r
+                out.metrics.update({f"{pre}{k2}": v for k2, v in normals_headline(r, group).items()})
+    return out

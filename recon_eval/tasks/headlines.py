@@ -60,3 +60,12 @@ def tracks_headline(res: dict) -> dict:
     """The headline of point tracks (TAP-Vid's mean over the streams, ``score_streams``' result)."""
     mean = res["mean_over_streams"]
     return {k: mean[k] for k in ("average_jaccard", "average_pts_within", "occlusion_accuracy")}
+
+
+def normals_headline(r, group: str) -> dict:
+    """The headline of a normal map's errors over ``group`` (all, or an object's name; a
+    :class:`~recon_eval.metrics.normals.NormalResult`): DiLiGenT's mean and median angular error
+    and the share within 10 degrees, ``<group>.`` in front (photometric stereo runs, ``recon-eval
+    normals``)."""
+    return {f"{group}.mean_ae_deg": r.mean_ae_deg, f"{group}.median_ae_deg": r.median_ae_deg,
+            f"{group}.within_10deg": r.within_10deg}

@@ -226,6 +226,9 @@ def test_docs_worked_example_runs_as_written(wide, tmp_path, monkeypatch, capsys
     board = json.loads((tmp_path / "board/leaderboard.json").read_text())
     assert [r["inputs"]["method"] for r in board["runs"]] == ["my-fmatrix", "my-f-matches", "opencv-f-ransac"]
     assert {r["inputs"]["task"] for r in board["runs"]} == {"fundamental matrix"}  # one table on the page
+    # the estimate from the images shares its columns with OpenCV's (its SIFT set): ranked, not starred alone
+    shared = {"sampson_rms_px", "pose_err_deg", "f_distance_px"}
+    assert all(shared <= set(r["metrics"]) for r in board["runs"])
     page = (tmp_path / "board/leaderboard.html").read_text()
     assert page.count("<h2>fundamental matrix</h2>") == 1 and 'href="wide_baseline/my-fmatrix/report.html"' in page
     report = (tmp_path / "board/wide_baseline/my-fmatrix/report.html").read_text()
