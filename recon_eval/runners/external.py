@@ -108,6 +108,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "per photometric stereo set under distant lights: {images} its images in order, {lights} light_directions.txt "
          "and {intensities} light_intensities.txt (DiLiGenT's axes), {mask} (PNG, 255 on the objects); write an "
          "(H, W, 3) .npy normal map in DiLiGenT's axes to {out}; DiLiGenT's errors as woodham-ps", "external_views"),
+    Kind("cloud", "cloud", ("images", "out"),
+         "once: {images} is a folder of <view>.png (the cameras: {dataset}/cameras.json); write a point cloud or mesh "
+         "(.ply) to {out}; Tanks and Temples at 1 cm and Chamfer-L1 against the scene's meshes as recon-eval cloud",
+         "external_views"),
     Kind("tracks", "tracks", ("images", "queries", "out"),
          "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
          "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "

@@ -16,6 +16,12 @@ keypoint and absolute-pose methods (docs/ci.md, "Your own estimator"):
   and ``{mask}`` (PNG, 255 on the objects) -> ``{out}`` an (H, W, 3) ``.npy`` normal map in
   DiLiGenT's axes; DiLiGenT's angular errors over all objects and per object, as ``woodham-ps``
   and ``recon-eval normals`` (``all.mean_ae_deg``, ``<object>.median_ae_deg``, ``.within_10deg``).
+* ``cloud``: once: ``{images}`` a folder of ``<view>.png`` (the calibrated cameras are the
+  dataset's ``cameras.json``, ``{dataset}``) -> ``{out}`` a ``.ply`` point cloud or mesh (its
+  vertices are scored); against the scene's meshes as ``recon-eval cloud`` at its defaults:
+  Tanks and Temples at 1 cm (a 200 000-point surface sample, seed 0, tau/2 voxel downsampling) and
+  Chamfer-L1 (``tnt_precision_at_1cm``, ``tnt_recall_at_1cm``, ``tnt_fscore_at_1cm``,
+  ``chamfer_l1_m``).
 """
 from __future__ import annotations
 
@@ -25,21 +31,27 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError, NotApplicable
+from recon_eval.metrics.distances import MeshSurface, sample_mesh_surface
 from recon_eval.metrics.normals import normal_metrics
 from recon_eval.metrics.pnp import pnp_errors
+from recon_eval.metrics.pointcloud import chamfer, tanks_and_temples
 from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.npy import read_npy
 from recon_eval.readers.photometric import photometric_sets
+from recon_eval.readers.ply import read_geometry
 from recon_eval.runners import pnp as pnp_runner
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.external import failed_output, invoke
 from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
-from recon_eval.tasks.headlines import normals_headline
+from recon_eval.tasks.headlines import CLOUD_TAU_M, cloud_headline, normals_headline
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.files import atomic_write_bytes
 from scenegen.dataset.layout import check_view_name
 from scenegen.geometry.camera import camera_model
 from scenegen.geometry.conventions import DILIGENT_FROM_OPENCV_CAM
+
+#: Truth surface samples of the cloud kind (``recon-eval cloud --gt-samples``' default).
+CLOUD_GT_SAMPLES = 200_000
 
 
 def features(ds, out_dir, options) -> RunOutput:
@@ -166,4 +178,32 @@ def normals(ds, out_dir, options) -> RunOutput:
                 r = normal_metrics(s.normals_cam, n_cv, m)
                 out.results[f"{pre}{group}.normals"] = r
                 out.metrics.update({f"{pre}{k2}": v for k2, v in normals_headline(r, group).items()})
+    return out
+
+
+def cloud(ds, out_dir, options) -> RunOutput:
+    """The ``cloud`` kind (module docstring)."""
+    images, ply = out_path(out_dir, "images/x").parent, out_path(out_dir, "cloud.ply")
+    shutil.rmtree(images, ignore_errors=True)
+    ply.unlink(missing_ok=True)
+    images.mkdir(parents=True)
+    for v in ds.views:
+        shutil.copy(ds.image_path(v), images / f"{check_view_name(v)}.png")
+    out = RunOutput()
+    why = invoke(options, {"images": str(images.resolve()), "out": str(ply.resolve()),
+                           "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs", "cloud", out)
+    shutil.rmtree(images, ignore_errors=True)  # the copies of the images
+    rec = np.zeros((0, 3))
+    if why is None:
+        try:
+            rec = read_geometry(ply).vertices
+            out.raw_files.append("cloud.ply")
+        except InputError as exc:  # an unreadable file: scored as an empty cloud
+            failed_output(out, "cloud", str(exc))
+    V, F = ds.mesh()
+    mesh = MeshSurface(V, F)
+    gt = sample_mesh_surface(V, F, CLOUD_GT_SAMPLES, seed=0)
+    out.results[f"tanks_and_temples@{CLOUD_TAU_M:g}m"] = tanks_and_temples(rec, gt, CLOUD_TAU_M, gt_mesh=mesh)
+    out.results["chamfer"] = chamfer(rec, gt, gt_mesh=mesh)
+    out.metrics.update(cloud_headline(out.results))
     return out

@@ -69,3 +69,17 @@ def normals_headline(r, group: str) -> dict:
     normals``)."""
     return {f"{group}.mean_ae_deg": r.mean_ae_deg, f"{group}.median_ae_deg": r.median_ae_deg,
             f"{group}.within_10deg": r.within_10deg}
+
+
+#: Tanks and Temples threshold of the cloud headline, metres (``recon-eval cloud``'s default --tau).
+CLOUD_TAU_M = 0.01
+
+
+def cloud_headline(res: dict) -> dict:
+    """The headline of a point cloud or mesh against the truth (``recon-eval cloud``'s result
+    groups at its defaults): Tanks and Temples at 1 cm and the Chamfer-L1 distance. (The SfM runs'
+    ``cloud_precision_at_1cm`` is another measure: their sparse points against the mesh's vertices,
+    without downsampling.)"""
+    tt, ch = res[f"tanks_and_temples@{CLOUD_TAU_M:g}m"], res["chamfer"]
+    return {"tnt_precision_at_1cm": tt.precision, "tnt_recall_at_1cm": tt.recall, "tnt_fscore_at_1cm": tt.fscore,
+            "chamfer_l1_m": ch.chamfer_l1_m}

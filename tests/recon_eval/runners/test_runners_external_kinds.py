@@ -135,3 +135,16 @@ def test_pnp_kind_equals_the_builtin_sqpnp_on_the_points_input(flow_dataset, tmp
     points = {k: v for k, v in ref["metrics"].items() if k.startswith("points.")}
     assert mine["metrics"] == points and mine["inputs"]["task"] == ref["inputs"]["task"]
     assert mine["metrics"]["points.failure_ratio"] == 0.0
+
+
+def test_cloud_kind_and_recon_eval_cloud_agree(plane_dataset, tmp_path):
+    """1681 points on the plane and one 0.5 m above it: precision 1681/1682 before downsampling (the
+    voxels keep each point apart at 5 mm), the same headline as ``recon-eval cloud --json``."""
+    root, _ = plane_dataset
+    doc = _run(root, "cloud", f"{{python}} {EST / 'plane_cloud.py'} {{out}}", tmp_path)
+    m = doc["metrics"]
+    assert m["tnt_precision_at_1cm"] == pytest.approx(1681 / 1682, abs=1e-12) and 0 < m["tnt_recall_at_1cm"] < 0.2
+    assert doc["inputs"]["task"] == "point clouds and meshes"
+    out = tmp_path / "c.json"
+    assert main(["cloud", str(tmp_path / "mine" / "cloud.ply"), str(root), "--json", str(out), "-q"]) == 0
+    assert json.loads(out.read_text())["metrics"] == m
