@@ -112,6 +112,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "once: {images} is a folder of <view>.png (the cameras: {dataset}/cameras.json); write a point cloud or mesh "
          "(.ply) to {out}; Tanks and Temples at 1 cm and Chamfer-L1 against the scene's meshes as recon-eval cloud",
          "external_views"),
+    Kind("triangulation", "triangulation", ("task", "out"),
+         "per triangulation task of opencv-triangulate (pixel noise 0 and 1 px): {task} the task folder (<pair>/P1.txt, "
+         "P2.txt, observations.txt); write <pair>.txt (X Y Z per observation row) into the folder {out}; scored as "
+         "opencv-triangulate", "external_views"),
     Kind("tracks", "tracks", ("images", "queries", "out"),
          "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
          "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "

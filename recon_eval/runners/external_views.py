@@ -22,6 +22,10 @@ keypoint and absolute-pose methods (docs/ci.md, "Your own estimator"):
   Tanks and Temples at 1 cm (a 200 000-point surface sample, seed 0, tau/2 voxel downsampling) and
   Chamfer-L1 (``tnt_precision_at_1cm``, ``tnt_recall_at_1cm``, ``tnt_fscore_at_1cm``,
   ``chamfer_l1_m``).
+* ``triangulation``: per triangulation task of ``opencv-triangulate`` (its pixel noises 0 and
+  1 px): ``{task}`` the task folder (``recon-eval triangulation-task``'s layout: ``<pair>/P1.txt``,
+  ``P2.txt``, ``observations.txt``) -> ``{out}`` a folder of ``<pair>.txt`` (``X Y Z`` per
+  observation row, world metres); scored as ``opencv-triangulate`` (``sigma0.median_err_m``, ...).
 """
 from __future__ import annotations
 
@@ -39,7 +43,7 @@ from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.npy import read_npy
 from recon_eval.readers.photometric import photometric_sets
 from recon_eval.readers.ply import read_geometry
-from recon_eval.runners import pnp as pnp_runner
+from recon_eval.runners import pnp as pnp_runner, triangulate as triangulate_runner
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.external import failed_output, invoke
 from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
@@ -207,3 +211,15 @@ def cloud(ds, out_dir, options) -> RunOutput:
     out.results["chamfer"] = chamfer(rec, gt, gt_mesh=mesh)
     out.metrics.update(cloud_headline(out.results))
     return out
+
+
+def triangulation(ds, out_dir, options) -> RunOutput:
+    """The ``triangulation`` kind (module docstring)."""
+    def answer(task_dir: Path, points_dir: Path, pairs: list, out: RunOutput) -> None:
+        shutil.rmtree(points_dir, ignore_errors=True)
+        points_dir.mkdir(parents=True)
+        invoke(options, {"task": str(task_dir.resolve()), "out": str(points_dir.resolve()),
+                         "dataset": str(Path(ds.root).resolve())}, Path(out_dir) / "logs" / task_dir.name,
+               task_dir.name, out)
+
+    return triangulate_runner.opencv(ds, Path(out_dir), options, answer=answer)

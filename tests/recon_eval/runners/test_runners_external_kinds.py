@@ -148,3 +148,13 @@ def test_cloud_kind_and_recon_eval_cloud_agree(plane_dataset, tmp_path):
     out = tmp_path / "c.json"
     assert main(["cloud", str(tmp_path / "mine" / "cloud.ply"), str(root), "--json", str(out), "-q"]) == 0
     assert json.loads(out.read_text())["metrics"] == m
+
+
+def test_triangulation_kind_equals_the_builtin(flow_dataset, tmp_path):
+    """A user's cv2.triangulatePoints script on the task folders: opencv-triangulate's numbers and names."""
+    root, _ = flow_dataset
+    mine = _run(root, "triangulation", f"{{python}} {EST / 'dlt_triangulate.py'} {{task}} {{out}}", tmp_path)
+    ref = run_method("opencv-triangulate", root, tmp_path / "ref")
+    assert mine["inputs"]["task"] == ref["inputs"]["task"] and set(mine["metrics"]) == set(ref["metrics"])
+    assert mine["metrics"] == pytest.approx(ref["metrics"], rel=1e-9, abs=1e-15)
+    assert mine["metrics"]["sigma0.median_err_m"] < 1e-9
