@@ -69,7 +69,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("external_more", "essential"): "essential matrix",
          ("external_more", "homography"): "homography", ("external_views", "features"): "keypoints and matches",
          ("external_views", "pnp"): "absolute pose (PnP)", ("external_views", "normals"): "photometric stereo",
-         ("external_views", "cloud"): "point clouds and meshes", ("external_views", "triangulation"): "triangulation", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
+         ("external_views", "cloud"): "point clouds and meshes", ("external_views", "triangulation"): "triangulation",
+         ("external_views", "dlt"): "DLT camera matrices", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
          ("external_sequence", "trajectory"): "camera trajectory"}
 
 

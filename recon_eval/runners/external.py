@@ -116,6 +116,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
          "per triangulation task of opencv-triangulate (pixel noise 0 and 1 px): {task} the task folder (<pair>/P1.txt, "
          "P2.txt, observations.txt); write <pair>.txt (X Y Z per observation row) into the folder {out}; scored as "
          "opencv-triangulate", "external_views"),
+    Kind("dlt", "dlt", ("points", "view", "out"),
+         "per view and input of dlt-linear (detected board corners, noisy truth points): {points} an (N, 5) .npy of "
+         "u v X Y Z (undistorted px, world m); write the camera matrix P (3x4 text) to {out}; scored as dlt-linear",
+         "external_views"),
     Kind("tracks", "tracks", ("images", "queries", "out"),
          "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
          "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "

@@ -26,6 +26,10 @@ keypoint and absolute-pose methods (docs/ci.md, "Your own estimator"):
   1 px): ``{task}`` the task folder (``recon-eval triangulation-task``'s layout: ``<pair>/P1.txt``,
   ``P2.txt``, ``observations.txt``) -> ``{out}`` a folder of ``<pair>.txt`` (``X Y Z`` per
   observation row, world metres); scored as ``opencv-triangulate`` (``sigma0.median_err_m``, ...).
+* ``dlt``: per view and input of ``dlt-linear`` (``targets``: detected board corners; ``points``:
+  noisy truth points): ``{points}`` an (N, 5) ``.npy`` of ``u v X Y Z`` (undistorted pixels, world
+  metres) -> ``{out}`` the camera matrix P (3x4 text); scored as ``dlt-linear``
+  (``targets.median_fx_rel_err``, ``points.median_rot_err_deg``, ...).
 """
 from __future__ import annotations
 
@@ -43,7 +47,8 @@ from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.npy import read_npy
 from recon_eval.readers.photometric import photometric_sets
 from recon_eval.readers.ply import read_geometry
-from recon_eval.runners import pnp as pnp_runner, triangulate as triangulate_runner
+from recon_eval.readers.rows import read_projection_matrix
+from recon_eval.runners import dlt as dlt_runner, pnp as pnp_runner, triangulate as triangulate_runner
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.external import failed_output, invoke
 from recon_eval.tasks.feature_eval import DEFAULT_EPS_PX, evaluate_features, headline_metrics, results_dict
@@ -223,3 +228,24 @@ def triangulation(ds, out_dir, options) -> RunOutput:
                task_dir.name, out)
 
     return triangulate_runner.opencv(ds, Path(out_dir), options, answer=answer)
+
+
+def dlt(ds, out_dir, options) -> RunOutput:
+    """The ``dlt`` kind (module docstring)."""
+    def fit(view: str, kind: str, x: np.ndarray, Xw: np.ndarray, out: RunOutput) -> np.ndarray:
+        item = f"{check_view_name(view)}/{kind}"
+        d = Path(out_dir) / "work" / item
+        d.mkdir(parents=True, exist_ok=True)
+        points, path = d / "points.npy", d / "P.txt"
+        np.save(points, np.concatenate([x, Xw], axis=1))
+        path.unlink(missing_ok=True)
+        values = {"points": str(points.resolve()), "view": check_view_name(view), "out": str(path.resolve()),
+                  "dataset": str(Path(ds.root).resolve())}
+        if invoke(options, values, d, item, out) is None:
+            try:
+                return read_projection_matrix(path)
+            except InputError as exc:  # the method's failure
+                failed_output(out, item, str(exc))
+        return np.full((3, 4), np.nan)
+
+    return dlt_runner.linear(ds, Path(out_dir), options, fit=fit)
