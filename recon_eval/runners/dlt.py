@@ -52,9 +52,9 @@ def _linear_fit(view: str, kind: str, x: np.ndarray, Xw: np.ndarray, out: RunOut
     return np.full((3, 4), np.nan)
 
 
-def linear(ds, out_dir, options, *, fit: Callable | None = None) -> RunOutput:
+def linear(ds, out_dir, options, *, estimate: Callable | None = None) -> RunOutput:
     """The DLT on every view's detected corners and noisy truth points (module docstring).
-    ``fit(view, kind, x (N, 2) undistorted px, X (N, 3) world m, out) -> P (3, 4)`` replaces it (an
+    ``estimate(view, kind, x (N, 2) undistorted px, X (N, 3) world m, out) -> P (3, 4)`` replaces it (an
     external estimator, :mod:`recon_eval.runners.external_views`; NaN: no estimate)."""
     all_points = np.asarray(list(board_points(ds).values())).reshape(-1, 3)
     if not is_three_dimensional(all_points):
@@ -81,7 +81,7 @@ def linear(ds, out_dir, options, *, fit: Callable | None = None) -> RunOutput:
         inputs = {"targets": (np.concatenate(xs or [np.zeros((0, 2))]), np.concatenate(Xs or [np.zeros((0, 3))])),
                   "points": (uv[fit] + rng.normal(0.0, POINT_SIGMA_PX, (len(fit), 2)), X[fit])}
         for kind, (x, Xw) in inputs.items():
-            P = (fit or _linear_fit)(v, kind, x, Xw, out)
+            P = (estimate or _linear_fit)(v, kind, x, Xw, out)
             rel = f"P/{kind}/{v}.txt"
             what = "detected corners" if kind == "targets" else "noisy truth points"
             P = _write_P(out_dir, rel, P, f"{len(x)} {what}")

@@ -248,4 +248,4 @@ def dlt(ds, out_dir, options) -> RunOutput:
                 failed_output(out, item, str(exc))
         return np.full((3, 4), np.nan)
 
-    return dlt_runner.linear(ds, Path(out_dir), options, fit=fit)
+    return dlt_runner.linear(ds, Path(out_dir), options, estimate=fit)
