@@ -158,3 +158,14 @@ def test_triangulation_kind_equals_the_builtin(flow_dataset, tmp_path):
     assert mine["inputs"]["task"] == ref["inputs"]["task"] and set(mine["metrics"]) == set(ref["metrics"])
     assert mine["metrics"] == pytest.approx(ref["metrics"], rel=1e-9, abs=1e-15)
     assert mine["metrics"]["sigma0.median_err_m"] < 1e-9
+
+
+def test_run_help_lists_every_kind(capsys):
+    """`run --help` prints each kind's argv contract (a '%' in a contract once broke argparse)."""
+    from recon_eval.runners.external import KINDS
+
+    with pytest.raises(SystemExit) as e:
+        main(["run", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert e.value.code == 0 and all(f"{k}: " in out for k in KINDS)
+    assert "30 % outliers" in out
