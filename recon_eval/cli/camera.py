@@ -16,6 +16,7 @@ from recon_eval.readers.pose_file import read_pose
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
+from recon_eval.tasks.headlines import calibration_headline
 
 
 # --- calibration ------------------------------------------------------------------------------
@@ -142,4 +143,10 @@ def score_pnp(a):
     return inputs, {"pnp": pnp_errors(R_est, t_est, R_gt, t_gt, cam=cam, points_world=X, pixels=uv)}, no_figures
 
 
-COMMANDS = {"calibration": scored(calibration_arguments, score_calibration), "pnp": scored(pnp_arguments, score_pnp)}
+def calibration_metrics(a, res) -> dict:
+    """``metrics`` of ``calibration --json``: the names a calibration run gives the same numbers."""
+    return calibration_headline(res["intrinsics"], res["projection_diff"], res.get("reprojection_held_out"))
+
+
+COMMANDS = {"calibration": scored(calibration_arguments, score_calibration, calibration_metrics),
+            "pnp": scored(pnp_arguments, score_pnp)}

@@ -32,7 +32,7 @@ def run_arguments(p) -> None:
     p.add_argument("--command", metavar="CMD", dest="external_command", help="run your own estimator: a command line with placeholders "
                                                     "({images} {out} ..., per --kind; no shell)")
     p.add_argument("--kind", choices=list(KINDS), help="--command: what it writes, and so how it is scored: "
-                   + "; ".join(f"{k.name}: {k.contract}" for k in KINDS.values()))
+                   + "; ".join(f"{k.name}: {k.contract}" for k in KINDS.values()).replace("%", "%%"))  # argparse formats help
     p.add_argument("--name", default="external", help="--command: the method name in the results (default external)")
     p.add_argument("--timeout", type=float, default=TIMEOUT_S, metavar="S",
                    help=f"--command: seconds per invocation (default {TIMEOUT_S:g})")

@@ -11,6 +11,8 @@ per pair, per series and over all pairs (:mod:`recon_eval.tasks.feature_eval`, d
 """
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from recon_eval.cli.common import stderr_progress
@@ -20,7 +22,7 @@ from recon_eval.readers.features import read_feature_files
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
-from recon_eval.tasks.feature_eval import evaluate_features, results_dict, select_pairs
+from recon_eval.tasks.feature_eval import evaluate_features, headline_metrics, results_dict, select_pairs
 
 
 def arguments(p) -> None:
@@ -83,4 +85,11 @@ def feature_figures(ev) -> list:
     return figs
 
 
-COMMANDS = {"features": scored(arguments, score)}
+def features_headline(a, results) -> dict:
+    """``metrics`` of ``features --json``: the headline a features run gives the same numbers
+    (:func:`recon_eval.tasks.feature_eval.headline_metrics`)."""
+    series = tuple(v for k, v in results.items() if k.startswith("series."))
+    return headline_metrics(SimpleNamespace(overall=results["overall"], series=series))
+
+
+COMMANDS = {"features": scored(arguments, score, features_headline)}

@@ -14,6 +14,7 @@ from recon_eval.metrics.flow import flow_metrics
 from recon_eval.readers.flow import FLOW_SUFFIXES, read_flow
 from recon_eval.readers.kitti_png import read_kitti_obj_map
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
+from recon_eval.tasks.headlines import flow_headline
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE
 
 
@@ -96,4 +97,4 @@ def score(a):
     return inputs, res, no_figures
 
 
-COMMANDS = {"flow": scored(arguments, score)}
+COMMANDS = {"flow": scored(arguments, score, lambda a, res: flow_headline(res["flow"]))}

@@ -4,6 +4,7 @@ dataset's truth (docs/metrics.md, "Stereo disparity", "Depth maps"). Map formats
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,8 @@ from recon_eval.readers.registry import find_view_map, read_map
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
+from recon_eval.tasks.disparity_sign import reversed_sign_hint
+from recon_eval.tasks.headlines import depth_headline
 
 
 # --- disparity --------------------------------------------------------------------------------
@@ -55,6 +58,8 @@ def score_disparity(a):
         needs_dataset_for_view(a)
         gt = read_map(a.gt, "disparity")
     same_shape(est, gt, a.est, a.gt)
+    if hint := reversed_sign_hint(est, gt):  # ~100 % bad with no other clue
+        print(f"recon-eval: warning: {a.method or a.est}: {hint}", file=sys.stderr)
     mask = None
     if a.gt_noc and a.benchmark != "kitti" and is_middlebury_mask(a.gt_noc):
         mask, noc = read_middlebury_mask(a.gt_noc), None
@@ -229,4 +234,5 @@ def score_depth(a):
     return inputs, res, figures
 
 
-COMMANDS = {"disparity": scored(disparity_arguments, score_disparity), "depth": scored(depth_arguments, score_depth)}
+COMMANDS = {"disparity": scored(disparity_arguments, score_disparity),
+            "depth": scored(depth_arguments, score_depth, lambda a, res: depth_headline(res["eigen"], a.alignment))}

@@ -13,6 +13,7 @@ from recon_eval.readers.normal_map import read_light_rows, read_normal_map
 from recon_eval.readers.npy import read_npy
 from recon_eval.readers.photometric import photometric_sets
 from recon_eval.readers.scenegen_dataset import is_dataset
+from recon_eval.tasks.headlines import normals_headline
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
 from scenegen.geometry.conventions import DILIGENT_FROM_OPENCV_CAM
@@ -98,4 +99,15 @@ def score(a):
     return inputs, res, no_figures
 
 
-COMMANDS = {"normals": scored(arguments, score)}
+def metrics(a, res) -> dict:
+    """``metrics`` of ``normals --json``: the names a photometric stereo run gives the same numbers."""
+    out = {}
+    for key, r in res.items():
+        if key.endswith(".normals"):
+            out.update(normals_headline(r, key.removesuffix(".normals")))
+    if "all.albedo" in res:
+        out["all.albedo_rel_mae"] = res["all.albedo"].rel_mae
+    return out
+
+
+COMMANDS = {"normals": scored(arguments, score, metrics)}

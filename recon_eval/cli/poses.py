@@ -16,6 +16,7 @@ from recon_eval.readers.registry import read_poses
 from recon_eval.readers.tum import associate
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
+from recon_eval.tasks.headlines import trajectory_headline
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
@@ -135,4 +136,4 @@ def score(a):
     return inputs, res, figures
 
 
-COMMANDS = {"poses": scored(arguments, score)}
+COMMANDS = {"poses": scored(arguments, score, lambda a, res: trajectory_headline(res["ape"], res["rpe"], a.alignment))}

@@ -12,7 +12,7 @@ from typing import Callable
 from recon_eval.cli.registry import Impl
 from recon_eval.errors import InputError
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
-from recon_eval.report.document import document, print_table, write_json_atomic
+from recon_eval.report.document import document, print_table, to_jsonable, write_json_atomic
 from recon_eval.report.html import render_html, write_html_atomic
 
 
@@ -20,9 +20,12 @@ def no_figures() -> list:
     return []
 
 
-def scored(arguments: Callable, score: Callable) -> Impl:
+def scored(arguments: Callable, score: Callable, headline: Callable | None = None) -> Impl:
     """The :class:`Impl` of a scored command: ``--json``, ``--html`` and ``--quiet``, then the
-    command's own ``arguments(parser)``; running it calls ``score(args)`` and reports."""
+    command's own ``arguments(parser)``; running it calls ``score(args)`` and reports.
+    ``headline(args, results) -> {name: number}`` gives the JSON's ``metrics``: the headline numbers
+    under the names ``recon-eval run`` gives the same numbers (docs/ci.md, "Metric paths"), so one
+    gate file gates a method run and the same method scored by hand."""
 
     def add(p) -> None:
         p.add_argument("--json", metavar="OUT", help="write the JSON report here (atomically)")
@@ -38,16 +41,20 @@ def scored(arguments: Callable, score: Callable) -> Impl:
     def run(a) -> int:
         inputs, results, figures = score(a)
         inputs = label_inputs(inputs, a)
+        metrics = headline(a, results) if headline is not None else None
         if not a.quiet:
             print_table(f"recon-eval {a.command}", results)
         if a.json:
-            write_json_atomic(a.json, document(a.command, inputs, results))
+            doc = document(a.command, inputs, results)
+            if metrics is not None:
+                doc["metrics"] = to_jsonable(metrics)
+            write_json_atomic(a.json, doc)
         if a.html:
             try:
                 import matplotlib  # noqa: F401  (optional: only the HTML report's figures need it)
             except ImportError:
                 raise InputError("--html needs matplotlib (pip install matplotlib)") from None
-            write_html_atomic(a.html, render_html(a.command, inputs, results, figures()))
+            write_html_atomic(a.html, render_html(a.command, inputs, results, figures(), metrics=metrics))
         return 0
 
     return Impl(add, run)

@@ -11,6 +11,7 @@ from recon_eval.errors import InputError
 from recon_eval.metrics.tapvid import QUERY_MODES, TAPVID_EVAL_SIZE
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.readers.tracks import read_tracks
+from recon_eval.tasks.headlines import tracks_headline
 from recon_eval.tasks.tracks import score_streams
 from scenegen.dataset.layout import check_name
 
@@ -57,4 +58,11 @@ def score(a):
     return inputs, res, no_figures
 
 
-COMMANDS = {"tracks": scored(arguments, score)}
+def metrics(a, res) -> dict:
+    """``metrics`` of ``tracks --json``: the names a tracks run gives the same numbers (query mode
+    ``first`` at TAP-Vid's 256 x 256); another query mode or ``--native-resolution`` in front."""
+    pre = ("" if a.query_mode == "first" else f"{a.query_mode}.") + ("native." if a.native_resolution else "")
+    return {pre + k: v for k, v in tracks_headline(res).items()}
+
+
+COMMANDS = {"tracks": scored(arguments, score, metrics)}

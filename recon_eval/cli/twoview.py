@@ -2,6 +2,7 @@
 (docs/metrics.md, "Fundamental matrices and homographies")."""
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -17,7 +18,8 @@ from recon_eval.readers.registry import read_image
 from recon_eval.readers.scenegen_dataset import read_dataset
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
-from recon_eval.tasks.fmatrix_pair import PIXELS, PairTruth, pair_truth, score_pair
+from recon_eval.tasks.fmatrix_pair import (IMAGES_SET, PIXELS, PairTruth, headline, headline_prefix, pair_truth,
+                                           score_pair, unusable_f_warning)
 from scenegen.dataset.layout import MATCH_KINDS
 
 
@@ -100,6 +102,9 @@ def score_fmatrix(a):
     elif a.labels:
         raise InputError("--labels needs --inliers MASK (the estimator's mask over the same rows)")
     res = score_pair(F, truth, inliers=inliers, labels=labels)
+    item = f"{a.views[0]}__{a.views[1]}" if a.dataset else a.f_est
+    if w := unusable_f_warning(res["fundamental"], item):  # a NaN F is scored inf: say so
+        print(f"recon-eval: warning: {a.method or a.f_est}: {w}", file=sys.stderr)
     if not a.dataset:
         del res["pose_via_K"]  # no cameras without a dataset
     if a.images:
@@ -123,6 +128,14 @@ def score_fmatrix(a):
     return inputs, res, figures
 
 
+def fmatrix_headline(a, res) -> dict:
+    """``metrics`` of ``fmatrix --json``: the names an F method's run gives the same numbers
+    (:func:`recon_eval.tasks.fmatrix_pair.headline`): ``sampson_rms_px``, ``pose_err_deg``,
+    ``f_distance_px`` (and ``inlier_recall``, ``inlier_precision``); with ``--match-set synthetic``
+    the estimate is of that set, named ``synthetic.`` as the runs name it."""
+    return headline(res, headline_prefix(*(a.views or ("", "")), a.match_set or IMAGES_SET, 1))
+
+
 # --- homography -------------------------------------------------------------------------------
 def homography_arguments(p) -> None:
     p.add_argument("h_est", help="estimated H (.txt/.npy/.json)")
@@ -141,5 +154,5 @@ def score_homography(a):
             {"homography": r, "summary": homography_summary([r.mace_px])}, no_figures)
 
 
-COMMANDS = {"fmatrix": scored(fmatrix_arguments, score_fmatrix),
+COMMANDS = {"fmatrix": scored(fmatrix_arguments, score_fmatrix, fmatrix_headline),
             "homography": scored(homography_arguments, score_homography)}

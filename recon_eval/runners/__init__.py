@@ -22,6 +22,7 @@ next to the raw outputs.
 from __future__ import annotations
 
 import importlib
+import sys
 from dataclasses import dataclass
 from difflib import get_close_matches
 from pathlib import Path
@@ -63,7 +64,14 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix",
          ("external", "disparity"): "stereo disparity",
-         ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration"}
+         ("external", "sfm"): "structure from motion", ("external", "calibration"): "calibration",
+         ("external_more", "flow"): "optical flow", ("external_more", "depth"): "depth maps",
+         ("external_more", "essential"): "essential matrix",
+         ("external_more", "homography"): "homography", ("external_views", "features"): "keypoints and matches",
+         ("external_views", "pnp"): "absolute pose (PnP)", ("external_views", "normals"): "photometric stereo",
+         ("external_views", "cloud"): "point clouds and meshes", ("external_views", "triangulation"): "triangulation",
+         ("external_views", "dlt"): "DLT camera matrices", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
+         ("external_sequence", "trajectory"): "camera trajectory"}
 
 
 def _m(name, module, function, description, **options):
@@ -169,10 +177,14 @@ def run_method(name: str, dataset, out_dir, *, write: bool = True, declared: dic
     fn = getattr(importlib.import_module(f"recon_eval.runners.{m.module}"), m.function)
     with Timer() as t:
         res: RunOutput = fn(ds, out, dict(m.options))
+    for w in res.warnings:
+        print(f"recon-eval: warning: {m.name}: {w}", file=sys.stderr)
     inputs = {"method": m.name, "task": m.task, "description": m.description, "options": dict(m.options),
               "dataset": str(dataset), "scene": ds.scene_name, "raw_files": res.raw_files,
               "notes": res.notes, "seconds": t.s, "opencv_version": cv2.__version__,
               "run_schema_version": RUN_SCHEMA_VERSION}
+    if res.warnings:
+        inputs["warnings"] = list(res.warnings)
     doc = document("run", inputs, res.results)
     doc["metrics"] = to_jsonable(res.metrics)
     if write:

@@ -24,6 +24,7 @@ from recon_eval.errors import NotApplicable
 from recon_eval.metrics.calibration import intrinsics_errors, projection_difference, reprojection_rms
 from recon_eval.readers.opencv_calib import read_opencv_calibration
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.headlines import calibration_headline
 from scenegen.geometry.camera import camera_model
 from scenegen.geometry.color import to_grey8
 
@@ -128,13 +129,7 @@ def score_calibration(ds, out: RunOutput, key: str, pre: str, yaml_path, views_u
     out.results[f"{key}.projection_diff"] = pdiff
     out.results[f"{key}.reprojection_held_out"] = rep
     m = out.metrics
-    m[pre + "fx_rel_err"] = ie.fx_rel_err
-    m[pre + "fy_rel_err"] = ie.fy_rel_err
-    m[pre + "cx_abs_err_px"] = ie.cx_abs_err_px
-    m[pre + "cy_abs_err_px"] = ie.cy_abs_err_px
-    m[pre + "proj_diff_rms_px"] = pdiff.rms_px
-    m[pre + "proj_diff_max_px"] = pdiff.max_px
-    m[pre + "held_out_reproj_rms_px"] = rep.rms_px
+    m.update(calibration_headline(ie, pdiff, rep, pre))
     if rms is not None:
         m[pre + "calib_rms_px"] = float(rms)
         m[pre + "views_used_ratio"] = len(views_used) / len(views_all)

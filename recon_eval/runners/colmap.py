@@ -30,6 +30,7 @@ from recon_eval.metrics.poses import Poses, ape, registration_ratio
 from recon_eval.readers.colmap_binary import read_colmap_binary
 from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.headlines import poses_headline
 
 #: Distance threshold of the sparse-cloud accuracy, metres (Tanks-and-Temples-style precision).
 TAU_M = 0.01
@@ -111,12 +112,9 @@ def score_model(ds, model_dir, out: RunOutput, *, n_registered: int | None = Non
         return out
     a = ape(est, gt, alignment=Alignment.SIM3)
     out.results["ape_sim3"] = a
-    rr = registration_ratio(est, gt)
-    rot = np.asarray(a.rot_err_deg, float)
     pts = np.asarray(est_model.points_world, float).reshape(-1, 3)
-    out.metrics.update({"registration_ratio": rr, "max_rot_err_deg": float(np.max(rot)),
-                        "median_rot_err_deg": float(np.median(rot)),
-                        "n_points3d": int(len(pts) if n_points is None else n_points)})
+    out.metrics.update(poses_headline(a, "sim3"))  # the names of ``recon-eval poses --json``
+    out.metrics["n_points3d"] = int(len(pts) if n_points is None else n_points)
     if len(pts):
         pw = a.tgt_from_src.apply(pts)
         V, F = ds.mesh()

@@ -27,12 +27,16 @@ class RunOutput:
     ``results``: metric group -> result dataclass or dict (serialised by recon_eval.report);
     ``metrics``: flat headline metrics, name -> float (what gates and the leaderboard read first);
     ``raw_files``: the estimator's own output files, relative to the run folder;
-    ``notes``: what the runner did that a reader must know (detections dropped, options)."""
+    ``notes``: what the runner did that a reader must know (detections dropped, options);
+    ``warnings``: silent-looking bad output worth a line on stderr (a non-finite F scored inf, a
+    disparity of the wrong sign): :func:`recon_eval.runners.run_method` prints each naming the
+    method and keeps them in ``inputs.warnings``."""
 
     results: dict = field(default_factory=dict)
     metrics: dict = field(default_factory=dict)
     raw_files: list = field(default_factory=list)
     notes: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
 
 
 def crossview_pairs(ds) -> tuple:

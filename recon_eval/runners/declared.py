@@ -42,7 +42,7 @@ def external_method(name: str, kind: str, command: str, *, timeout_s: float = TI
         if kind != "fmatrix" or pixels not in PIXELS:
             raise InputError(f"{field_at(declared_at, 'pixels')}: only for kind fmatrix, one of {', '.join(PIXELS)}")
         opts["pixels"] = pixels
-    return Method(name, "external", KINDS[kind].function, description or f"external {kind}: {command}",
+    return Method(name, KINDS[kind].module, KINDS[kind].function, description or f"external {kind}: {command}",
                   tuple(sorted(opts.items())))
 
 

@@ -18,6 +18,8 @@ median over views. NotApplicable when the dataset's board points are coplanar (o
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from recon_eval.errors import NotApplicable
@@ -43,7 +45,17 @@ def _write_P(out_dir, rel: str, P: np.ndarray, what: str) -> np.ndarray:
     return read_projection_matrix(p)
 
 
-def linear(ds, out_dir, options) -> RunOutput:
+def _linear_fit(view: str, kind: str, x: np.ndarray, Xw: np.ndarray, out: RunOutput) -> np.ndarray:
+    """The normalised linear DLT, or NaN below its minimum (MIN_POINTS, non-coplanar points)."""
+    if len(x) >= MIN_POINTS and is_three_dimensional(Xw):
+        return dlt_projection(Xw, x)
+    return np.full((3, 4), np.nan)
+
+
+def linear(ds, out_dir, options, *, estimate: Callable | None = None) -> RunOutput:
+    """The DLT on every view's detected corners and noisy truth points (module docstring).
+    ``estimate(view, kind, x (N, 2) undistorted px, X (N, 3) world m, out) -> P (3, 4)`` replaces it (an
+    external estimator, :mod:`recon_eval.runners.external_views`; NaN: no estimate)."""
     all_points = np.asarray(list(board_points(ds).values())).reshape(-1, 3)
     if not is_three_dimensional(all_points):
         raise NotApplicable(f"{ds.root}: no non-coplanar board points (the DLT needs a 3D calibration object: "
@@ -69,10 +81,7 @@ def linear(ds, out_dir, options) -> RunOutput:
         inputs = {"targets": (np.concatenate(xs or [np.zeros((0, 2))]), np.concatenate(Xs or [np.zeros((0, 3))])),
                   "points": (uv[fit] + rng.normal(0.0, POINT_SIGMA_PX, (len(fit), 2)), X[fit])}
         for kind, (x, Xw) in inputs.items():
-            if len(x) >= MIN_POINTS and is_three_dimensional(Xw):
-                P = dlt_projection(Xw, x)
-            else:
-                P = np.full((3, 4), np.nan)
+            P = (estimate or _linear_fit)(v, kind, x, Xw, out)
             rel = f"P/{kind}/{v}.txt"
             what = "detected corners" if kind == "targets" else "noisy truth points"
             P = _write_P(out_dir, rel, P, f"{len(x)} {what}")

@@ -44,7 +44,7 @@ from recon_eval.readers.pfm import read_pfm
 from recon_eval.runners import calibration as calib, colmap, stereo, twoview
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
 from recon_eval.runners.process_group import run_group
-from recon_eval.tasks.fmatrix_pair import PIXELS, pair_truth, score_pair
+from recon_eval.tasks.fmatrix_pair import PIXELS, headline, pair_truth, score_pair, unusable_f_warning
 from scenegen.dataset.layout import check_view_name
 
 #: Default per-invocation timeout, seconds.
@@ -59,9 +59,10 @@ class Kind:
     """An output kind: what the command is given and must write, and how it is scored."""
 
     name: str
-    function: str  # the runner function of this module
+    function: str  # the runner function of ``module``
     placeholders: tuple  # the names the command may use ({python} and {dataset} always)
     contract: str  # one line for --help and the docs
+    module: str = "external"  # recon_eval.runners.<module>: this one, or external_more
 
 
 KINDS: dict[str, Kind] = {k.name: k for k in [
@@ -80,6 +81,53 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("sfm", "sfm", ("images", "out"),
          "once: {images} is a folder of <view>.png, write a COLMAP model (cameras, images, points3D; .bin or .txt; "
          "image names <view>.png) into the folder {out}; scored as pycolmap-incremental"),
+    Kind("flow", "flow", ("image1", "image2", "view1", "view2", "out"),
+         "per flow pair (a sequence's frame pairs, else both directions of each cross-view pair): read {image1} "
+         "{image2}, write the flow image1 -> image2 (Middlebury .flo, px) to {out}; scored as opencv-flow-dis",
+         "external_more"),
+    Kind("depth", "depth", ("image", "view", "out"),
+         "per view: read {image}, write its z-depth (an (H, W) .npy, metres; NaN/inf/<=0 = none) to {out}; Eigen's "
+         "metrics without alignment and with median scaling, as recon-eval depth", "external_more"),
+    Kind("essential", "essential", ("images", "image1", "image2", "view1", "view2", "k1", "k2", "out"),
+         "per cross-view pair: read {images} and the intrinsics {k1} {k2} (3x3 text), write E (3x3 text, "
+         "x2n^T E x1n = 0 on normalised undistorted coordinates) to {out}; the pose recovered on the truth "
+         "correspondences is scored as the built-in E methods", "external_more"),
+    Kind("homography", "homography", ("images", "image1", "image2", "view1", "view2", "plane", "mask", "out"),
+         "per cross-view pair and plane with a truth homography: read {images}, {plane} (its name) and {mask} (PNG of "
+         "image 1, 255 on the plane); write H (3x3 text, x2 ~ H x1, undistorted pixels) to {out}; the mean corner "
+         "error as the built-in H methods", "external_more"),
+    Kind("features", "features", ("images", "pairs", "out"),
+         "once: {images} is a folder of <view>.png, {pairs} a text file of the cross-view pairs (view_i view_j per "
+         "line); write keypoints/<view>.txt and matches/<view_i>__<view_j>.txt (docs/features.md) into the folder "
+         "{out}; scored as opencv-features-* and recon-eval features", "external_views"),
+    Kind("pnp", "pnp", ("image", "view", "points", "k", "dist", "out"),
+         "per view: {points} is an (N, 5) .npy of u v X Y Z (noisy truth pixels with 30 % outliers, world metres), "
+         "{k} and {dist} the camera's K (3x3) and OpenCV distortion (text); write cam_from_world [R | t] (3x4 text) "
+         "to {out}; scored as the built-in PnP methods' points input", "external_views"),
+    Kind("normals", "normals", ("images", "lights", "intensities", "mask", "out"),
+         "per photometric stereo set under distant lights: {images} its images in order, {lights} light_directions.txt "
+         "and {intensities} light_intensities.txt (DiLiGenT's axes), {mask} (PNG, 255 on the objects); write an "
+         "(H, W, 3) .npy normal map in DiLiGenT's axes to {out}; DiLiGenT's errors as woodham-ps", "external_views"),
+    Kind("cloud", "cloud", ("images", "out"),
+         "once: {images} is a folder of <view>.png (the cameras: {dataset}/cameras.json); write a point cloud or mesh "
+         "(.ply) to {out}; Tanks and Temples at 1 cm and Chamfer-L1 against the scene's meshes as recon-eval cloud",
+         "external_views"),
+    Kind("triangulation", "triangulation", ("task", "out"),
+         "per triangulation task of opencv-triangulate (pixel noise 0 and 1 px): {task} the task folder (<pair>/P1.txt, "
+         "P2.txt, observations.txt); write <pair>.txt (X Y Z per observation row) into the folder {out}; scored as "
+         "opencv-triangulate", "external_views"),
+    Kind("dlt", "dlt", ("points", "view", "out"),
+         "per view and input of dlt-linear (detected board corners, noisy truth points): {points} an (N, 5) .npy of "
+         "u v X Y Z (undistorted px, world m); write the camera matrix P (3x4 text) to {out}; scored as dlt-linear",
+         "external_views"),
+    Kind("tracks", "tracks", ("images", "queries", "out"),
+         "per point-track stream of a sequence: {images} its frames in order, {queries} an (N, 3) .npy of query points "
+         "t y x; write an .npz of tracks_xy (N, T, 2) px and occluded (N, T) to {out}; TAP-Vid's metrics as "
+         "opencv-lk-tapvid", "external_sequence"),
+    Kind("trajectory", "trajectory", ("images", "times", "camera", "k", "dist", "out"),
+         "per camera stream of 3+ frames: {images} its frames in time order, {times} lines 'timestamp image', {k} "
+         "{dist} its K and distortion (text); write a TUM trajectory (timestamp tx ty tz qx qy qz qw, world_from_cam) "
+         "to {out}; APE (Sim(3)) and RPE as recon-eval poses", "external_sequence"),
 ]}
 ALWAYS = ("python", "dataset")
 #: ``declared_at`` of a method made by ``recon-eval run --command``, and the option of each field
@@ -169,19 +217,20 @@ def _last_lines(path: Path) -> list[str]:
         return f.read().decode("utf-8", "replace").strip().splitlines()[-STDERR_LINES:]
 
 
-def _failed_output(out, item: str, why: str) -> None:
+def failed_output(out, item: str, why: str) -> None:
+    """Record (notes) and say (stderr) that the method's output for ``item`` is missing or unreadable."""
     out.notes.setdefault(item, {})["failed"] = why
     print(f"recon-eval: {item}: {why}", file=sys.stderr)
 
 
 def _read_f(path: Path, out, item: str):
     if not path.is_file():
-        _failed_output(out, item, f"wrote no {path.name}")
+        failed_output(out, item, f"wrote no {path.name}")
         return None
     try:
         return read_matrix3(path, key="F")
     except InputError as exc:
-        _failed_output(out, item, str(exc))
+        failed_output(out, item, str(exc))
         return None
 
 
@@ -213,13 +262,12 @@ def fmatrix(ds, out_dir, options) -> RunOutput:
             out.raw_files.append(f"{key}/F.txt")
         truth = pair_truth(ds, i, j, pixels=pixels, max_points=twoview.TRUTH_POINTS)
         res = score_pair(F, truth, zhang_if_failed=False)
+        if failed is None and out.notes.get(key, {}).get("failed") is None:  # the method's own F, unusable
+            if w := unusable_f_warning(res["fundamental"], key):
+                out.warnings.append(w)
         for group, r in res.items():
             out.results[f"{key}.{group}"] = r
-        pre = "" if len(pairs) == 1 else f"{key}."
-        out.metrics.update({pre + "sampson_rms_px": res["fundamental"].sampson_rms_px,
-                            pre + "pose_err_deg": res["pose_via_K"].pose_err_deg})
-        if "zhang_f_distance" in res:
-            out.metrics[pre + "f_distance_px"] = res["zhang_f_distance"].f_distance_px
+        out.metrics.update(headline(res, "" if len(pairs) == 1 else f"{key}."))
         out.notes[f"{key}.truth"] = truth.notes
     if not out.results:
         raise NotApplicable(f"{ds.root}: the cross-view pairs are all zero-baseline: no fundamental matrix to estimate")
@@ -246,7 +294,7 @@ def _fmatrix_matches(ds, out_dir, options) -> RunOutput:
             try:
                 mask = read_mask(ipath, len(x1))
             except InputError as exc:
-                _failed_output(res_holder, item, str(exc))
+                failed_output(res_holder, item, str(exc))
                 return None, None
         return F, mask
 
@@ -265,12 +313,12 @@ def disparity(ds, out_dir, options) -> RunOutput:
                   "out": str(Path(path).resolve()), "dataset": str(Path(ds_.root).resolve())}
         if invoke(options, values, Path(out_dir) / "logs" / left, left, out) is None:
             if not path.is_file():
-                _failed_output(out, left, f"wrote no {path.name}")
+                failed_output(out, left, f"wrote no {path.name}")
                 return
             try:
                 read_pfm(path)
             except InputError as exc:
-                _failed_output(out, left, str(exc))
+                failed_output(out, left, str(exc))
                 path.unlink()
         else:
             path.unlink(missing_ok=True)
@@ -300,7 +348,7 @@ def sfm(ds, out_dir, options) -> RunOutput:
             out.raw_files += files
             return out
         except InputError as exc:  # an unreadable model is the method's failure, not bad input
-            _failed_output(out, "sfm", str(exc))
+            failed_output(out, "sfm", str(exc))
     out.metrics.update({"registration_ratio": 0.0, "max_rot_err_deg": float("inf")})
     return out
 
@@ -324,14 +372,14 @@ def calibration(ds, out_dir, options) -> RunOutput:
         shutil.rmtree(images, ignore_errors=True)
         pre = "" if len(groups) == 1 else f"{name}."
         if why is None and not yaml_path.is_file():
-            _failed_output(out, name, f"wrote no {yaml_path.name}")
+            failed_output(out, name, f"wrote no {yaml_path.name}")
         elif why is None:
             try:
                 calib.score_calibration(ds, out, name, pre, yaml_path, views, views, None)
                 out.raw_files.append(yaml_path.name)
                 continue
             except InputError as exc:  # an unreadable file is the method's failure
-                _failed_output(out, name, str(exc))
+                failed_output(out, name, str(exc))
         for k in ("fx_rel_err", "fy_rel_err", "cx_abs_err_px", "cy_abs_err_px", "proj_diff_rms_px"):
             out.metrics[pre + k] = float("inf")  # a failed calibration: every error inf, never dropped
     return out

@@ -25,12 +25,14 @@ from recon_eval.errors import NotApplicable
 from recon_eval.metrics.flow import flow_metrics, track_metrics
 from recon_eval.readers.flow import read_flow
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.headlines import flow_headline
 from scenegen.dataset.codecs import encode_flo
 from scenegen.dataset.files import atomic_write_bytes
 from scenegen.geometry.color import to_grey8
 
 
-def _pairs(ds) -> list:
+def pairs(ds) -> list:
+    """The flow pairs a flow method runs on: a sequence's, else both directions of each cross-view pair."""
     pairs = list(ds.flow_pairs())  # a sequence's frame pairs, else the cross-view flow pairs
     if not pairs:
         pairs = [p for i, j in ds.require_crossview_index().pairs for p in ((i, j), (j, i))]
@@ -48,7 +50,7 @@ def _dense(kind: str, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def dense(ds, out_dir, options) -> RunOutput:
     kind = options["algorithm"]
     est, gts, states, raw = [], [], [], []
-    for i, j in _pairs(ds):
+    for i, j in pairs(ds):
         f = _dense(kind, to_grey8(ds.image(i)), to_grey8(ds.image(j)))
         rel = f"flow/{i}__{j}.flo"
         atomic_write_bytes(out_path(out_dir, rel), encode_flo(f))
@@ -58,15 +60,13 @@ def dense(ds, out_dir, options) -> RunOutput:
         gts.append(g)
         states.append(st)
     r = flow_metrics(est, gts, states)
-    metrics = {"epe_all_px": r.epe_all_px, "epe_noc_px": r.epe_noc_px, "epe_occ_px": r.epe_occ_px,
-               "fl_all_all_pct": r.fl_all_all_pct, "s0_10_px": r.s0_10_px}
-    return RunOutput({"flow": r}, metrics, raw, {"pairs": len(raw), "opencv_flow": kind})
+    return RunOutput({"flow": r}, flow_headline(r), raw, {"pairs": len(raw), "opencv_flow": kind})
 
 
 def lk(ds, out_dir, options) -> RunOutput:
     raw, rows_all, results = [], [], {}
     starts, ends, status, gts, sts = [], [], [], [], []
-    for i, j in _pairs(ds):
+    for i, j in pairs(ds):
         a, b = to_grey8(ds.image(i)), to_grey8(ds.image(j))
         c = cv2.goodFeaturesToTrack(a, maxCorners=500, qualityLevel=0.01, minDistance=7)
         p0 = np.rint(np.zeros((0, 2)) if c is None else c.reshape(-1, 2)).astype(np.float32)

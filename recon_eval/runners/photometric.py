@@ -26,6 +26,7 @@ from recon_eval.errors import NotApplicable
 from recon_eval.metrics.normals import albedo_metrics, depth_up_to_offset, normal_metrics
 from recon_eval.readers.photometric import PhotometricSet, photometric_sets
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.headlines import normals_headline
 from scenegen.dataset.codecs import encode_npy
 from scenegen.dataset.files import atomic_write_bytes
 from scenegen.geometry.conventions import DILIGENT_FROM_OPENCV_CAM
@@ -106,8 +107,7 @@ def score_set(s: PhotometricSet, normals_cv: np.ndarray, albedo: np.ndarray, dep
             continue
         r = normal_metrics(s.normals_cam, normals_cv, m)
         results[f"{name}.normals"] = r
-        metrics.update({f"{name}.mean_ae_deg": r.mean_ae_deg, f"{name}.median_ae_deg": r.median_ae_deg,
-                        f"{name}.within_10deg": r.within_10deg})
+        metrics.update(normals_headline(r, name))
         if s.albedo is not None:
             a = albedo_metrics(s.albedo, albedo, m)
             results[f"{name}.albedo"] = a

@@ -52,6 +52,30 @@ def _solve(x, X, K, D, solver: str, ransac: bool):
     return (rvec.ravel(), tvec.ravel()) if ok else None
 
 
+def noisy_points(ds, view: str, cam, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """(pixels (N, 2) with N(0, POINT_SIGMA_PX^2) noise and OUTLIER_FRACTION uniform outliers,
+    world points (N, 3)) of ``view``: the ``points`` input (module docstring), drawn from ``rng``."""
+    uv, Xp = ds.points_at_pixels(view, max_points=POINTS_PER_VIEW, seed=SEED)
+    uv = uv + rng.normal(0.0, POINT_SIGMA_PX, uv.shape)
+    n_out = int(round(OUTLIER_FRACTION * len(uv)))
+    uv[:n_out] = rng.uniform((0, 0), (cam.width - 1, cam.height - 1), (n_out, 2))
+    return uv, Xp
+
+
+def headline(errs: dict, out: RunOutput) -> None:
+    """The headline of per-view errors ``errs[kind]`` = [(rot_err_deg, trans_err_m, failed,
+    reprojection rms px)]: medians over the views and the failure ratio, ``<kind>.`` in front."""
+    for kind, e in errs.items():
+        if not e:
+            continue
+        a = np.asarray([(x[0], x[1]) for x in e], float)
+        out.metrics[f"{kind}.median_rot_err_deg"] = float(np.median(a[:, 0]))
+        out.metrics[f"{kind}.median_trans_err_m"] = float(np.median(a[:, 1]))
+        out.metrics[f"{kind}.failure_ratio"] = float(np.mean([x[2] for x in e]))
+        if kind == "targets":  # the detections' fit residual; on ``points`` the outliers would swamp it
+            out.metrics[f"{kind}.median_reproj_rms_px"] = float(np.median([x[3] for x in e]))
+
+
 def run(ds, out_dir, options) -> RunOutput:
     solver, ransac = options["solver"], options["ransac"]
     targets = {n: b for n, b in ds.boards().items() if b[0]["kind"] in MARKER_BOARD_KINDS}
@@ -69,11 +93,7 @@ def run(ds, out_dir, options) -> RunOutput:
             x, X = detect_board_points(ds.image(v), geo, truth)
             if len(x) >= 4:
                 inputs[("targets", f"{v}.{name}")] = (x, X)
-        uv, Xp = ds.points_at_pixels(v, max_points=POINTS_PER_VIEW, seed=SEED)
-        uv = uv + rng.normal(0.0, POINT_SIGMA_PX, uv.shape)
-        n_out = int(round(OUTLIER_FRACTION * len(uv)))
-        uv[:n_out] = rng.uniform((0, 0), (cam.width - 1, cam.height - 1), (n_out, 2))
-        inputs[("points", v)] = (uv, Xp)
+        inputs[("points", v)] = noisy_points(ds, v, cam, rng)
         for (kind, key), (x, X) in inputs.items():
             s = _solve(x, X, K, D, solver, ransac)
             if s is None:
@@ -89,15 +109,7 @@ def run(ds, out_dir, options) -> RunOutput:
     path = out_path(out_dir, "poses.json")
     path.write_text(json.dumps(raw, indent=1))
     out.raw_files.append("poses.json")
-    for kind, e in errs.items():
-        if not e:
-            continue
-        a = np.asarray([(x[0], x[1]) for x in e], float)
-        out.metrics[f"{kind}.median_rot_err_deg"] = float(np.median(a[:, 0]))
-        out.metrics[f"{kind}.median_trans_err_m"] = float(np.median(a[:, 1]))
-        out.metrics[f"{kind}.failure_ratio"] = float(np.mean([x[2] for x in e]))
-        if kind == "targets":  # the detections' fit residual; on ``points`` the outliers would swamp it
-            out.metrics[f"{kind}.median_reproj_rms_px"] = float(np.median([x[3] for x in e]))
+    headline(errs, out)
     out.notes.update({"points_per_view": POINTS_PER_VIEW, "sigma_px": POINT_SIGMA_PX,
                       "outlier_fraction": OUTLIER_FRACTION, "ransac_threshold_px": RANSAC_THRESH_PX if ransac else None,
                       "target_views": len(errs["targets"])})

@@ -26,6 +26,7 @@ from recon_eval.errors import InputError, NotApplicable
 from recon_eval.metrics.stereo import two_view_metrics
 from recon_eval.readers.pfm import read_pfm
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.disparity_sign import reversed_sign_hint
 from scenegen.dataset.codecs import write_pfm
 from scenegen.geometry.color import to_grey8
 
@@ -84,6 +85,8 @@ def run(ds, out_dir, options, *, compute=None) -> RunOutput:
         ests.append(est)
         gts.append(gt)
         masks.append(noc)
+        if hint := reversed_sign_hint(est, gt, noc):
+            out.warnings.append(f"{left} (non-occluded): {hint}")
         ok = noc & np.isfinite(gt) & np.isfinite(est)
         signed.append((est - gt)[ok])
     # pooled over frames (Middlebury counts per pixel)

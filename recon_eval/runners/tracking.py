@@ -19,6 +19,7 @@ import numpy as np
 from recon_eval.metrics.tapvid import TAPVID_EVAL_SIZE
 from recon_eval.readers.tracks import read_tracks
 from recon_eval.runners.common import RunOutput, out_path
+from recon_eval.tasks.headlines import tracks_headline
 from recon_eval.tasks.tracks import score_streams
 from scenegen.dataset.codecs import encode_npz
 from scenegen.dataset.files import atomic_write_bytes
@@ -90,8 +91,5 @@ def lk_tapvid(ds, out_dir, options) -> RunOutput:
         raw.append(rel)
     res = score_streams(ds, streams, lambda s, n, t: read_tracks(out_path(out_dir, f"tracks/{s}.npz"), n, t),
                         query_mode="first", eval_size=TAPVID_EVAL_SIZE)
-    mean = res["mean_over_streams"]
-    metrics = {"average_jaccard": mean["average_jaccard"], "average_pts_within": mean["average_pts_within"],
-               "occlusion_accuracy": mean["occlusion_accuracy"]}
-    return RunOutput({"tapvid": res}, metrics, raw, {"streams": list(streams), "query_mode": "first",
+    return RunOutput({"tapvid": res}, tracks_headline(res), raw, {"streams": list(streams), "query_mode": "first",
                                                      "eval_size": list(TAPVID_EVAL_SIZE)})

@@ -12,6 +12,9 @@ relative error: float precision), and the median error per triangulation-angle b
 """
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Callable
+
 from recon_eval.errors import InputError, NotApplicable
 from recon_eval.runners.common import RunOutput, crossview_pairs
 from recon_eval.tasks import triangulation_task as tt
@@ -25,7 +28,17 @@ def _sigma_tag(s: float) -> str:
     return f"sigma{s:g}".replace(".", "p")
 
 
-def opencv(ds, out_dir, options) -> RunOutput:
+def _opencv_answer(task_dir: Path, points_dir: Path, pairs: list, out: RunOutput) -> None:
+    """cv2.triangulatePoints on each pair of the task read back, written as the answer files."""
+    for tp in pairs:
+        tt.write_points(points_dir / f"{tp.name}.txt", tt.reference_points(tp))
+
+
+def opencv(ds, out_dir, options, *, answer: Callable | None = None) -> RunOutput:
+    """OpenCV on the triangulation tasks of every sigma (module docstring). ``answer(task_dir,
+    points_dir, pairs, out)`` replaces OpenCV: it writes ``points_dir/<pair>.txt`` for the task in
+    ``task_dir`` (an external triangulator, :mod:`recon_eval.runners.external_views`); a missing
+    file is scored as failed points."""
     crossview_pairs(ds)  # NotApplicable without cross-view pairs
     out = RunOutput()
     try:
@@ -38,9 +51,9 @@ def opencv(ds, out_dir, options) -> RunOutput:
         tt.write_task(out_dir / f"task_{tag}", pairs, {"dataset": str(ds.root), "sigma_px": sigma, "seed": SEED,
                                                        "count": COUNT})
         _, pairs = tt.read_task(out_dir / f"task_{tag}")  # run on what was written
-        for tp in pairs:
-            tt.write_points(out_dir / f"points_{tag}" / f"{tp.name}.txt", tt.reference_points(tp))
-            out.raw_files.append(f"points_{tag}/{tp.name}.txt")
+        (answer or _opencv_answer)(Path(out_dir) / f"task_{tag}", Path(out_dir) / f"points_{tag}", pairs, out)
+        out.raw_files += [f"points_{tag}/{tp.name}.txt" for tp in pairs
+                          if (Path(out_dir) / f"points_{tag}" / f"{tp.name}.txt").is_file()]
         est, notes = tt.read_estimates(out_dir / f"points_{tag}", pairs)
         res = tt.score_task(pairs, est)
         for name, s in res.items():

@@ -30,6 +30,7 @@ from recon_eval.metrics.epipolar import (fundamental_metrics, homography_mace, i
                                          pose_error_from_fundamental, sampson_sq_px2, zhang_f_distance)
 from recon_eval.metrics.poses import relative_pose_errors_deg
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from recon_eval.tasks.fmatrix_pair import headline, headline_prefix, unusable_f_warning
 from scenegen.geometry.twoview import undistorted_pixels
 
 #: RANSAC-family thresholds, px. FM_RANSAC thresholds the larger point-to-epipolar-line distance
@@ -110,11 +111,15 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
                 F = min(sols, key=lambda G: float(np.median(sampson_sq_px2(G, x1[true_inl], x2[true_inl]))))
             key = f"{i}__{j}.{kind}"
             if F is None or np.asarray(F).shape != (3, 3):
+                out.warnings.append(f"{i}__{j} ({kind} matches): the estimator returned no F: scored as a failed "
+                                    f"estimate (sampson_rms_px inf)")
                 F, inl = np.full((3, 3), np.nan), np.zeros(n, bool)
+                returned = False
             else:
                 F = np.asarray(F, np.float64)
                 if transform_F is not None:
                     F = transform_F(F)
+                returned = True
                 inl = np.zeros(n, bool)
                 inl[np.flatnonzero(use)] = np.ones(int(use.sum()), bool) if mask is None else mask.ravel() != 0
             fpath = out_path(out_dir, f"{i}__{j}/{kind}_F.txt")
@@ -123,6 +128,8 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
             out.raw_files += [f"{i}__{j}/{kind}_F.txt", f"{i}__{j}/{kind}_inliers.npy"]
             F = np.loadtxt(fpath)  # score what was written
             fm = fundamental_metrics(F, t1, t2)
+            if returned and (w := unusable_f_warning(fm, f"{i}__{j} ({kind} matches)")):
+                out.warnings.append(w)
             ir = inlier_precision_recall(inl, true_inl)
             zd = zhang_f_distance(F, F_gt, (ci.width, ci.height), (cj.width, cj.height)) if not fm.failed else None
             pe = pose_error_from_fundamental(F, ci.K, cj.K, t1, t2, rel.R, rel.t)
@@ -131,9 +138,10 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
             if zd is not None:
                 out.results[f"{key}.zhang_f_distance"] = zd
             out.results[f"{key}.pose_via_K"] = pe
-            pre = f"{kind}." if len(pairs) == 1 else f"{key}."
-            out.metrics.update({pre + "sampson_rms_px": fm.sampson_rms_px, pre + "inlier_recall": ir.recall,
-                                pre + "inlier_precision": ir.precision, pre + "pose_err_deg": pe.pose_err_deg})
+            groups = {"fundamental": fm, "pose_via_K": pe, "inliers": ir}
+            if zd is not None:
+                groups["zhang_f_distance"] = zd
+            out.metrics.update(headline(groups, headline_prefix(i, j, kind, len(pairs))))
             out.notes[f"{key}.matches"] = {"n": int(n), "used": int(use.sum()),
                                            "true_inliers": int(true_inl.sum()),
                                            "threshold_px": _thresh(flag) if flag in THRESH_PX
@@ -179,7 +187,7 @@ def essential(ds, out_dir, options) -> RunOutput:
             ir = inlier_precision_recall(inl, ms.inliers)
             out.results[f"{key}.inliers"] = ir
             out.results[f"{key}.relative_pose"] = {"rot_err_deg": eR, "trans_dir_err_deg": et, "pose_err_deg": ep}
-            pre = f"{kind}." if len(pairs) == 1 else f"{key}."
+            pre = headline_prefix(i, j, kind, len(pairs))
             out.metrics.update({pre + "pose_err_deg": ep, pre + "rot_err_deg": eR, pre + "inlier_recall": ir.recall,
                                 pre + "inlier_precision": ir.precision})
     if not out.raw_files:
@@ -217,7 +225,7 @@ def homography(ds, out_dir, options) -> RunOutput:
                 out.raw_files.append(f"{i}__{j}/{kind}_{plane}_H.txt")
                 r = homography_mace(np.loadtxt(hp), H_gt, ci.width, ci.height)
                 out.results[f"{key}.homography"] = r
-                pre = f"{kind}.{plane}." if len(pairs) == 1 else f"{key}."
+                pre = headline_prefix(i, j, kind, len(pairs)) + f"{plane}."
                 out.metrics[pre + "mace_px"] = r.mace_px
                 out.notes[f"{key}.matches_on_plane"] = int(on.sum())
     if not out.raw_files:

@@ -100,3 +100,46 @@ def score_pair(F, truth: PairTruth, *, inliers=None, labels=None, zhang_if_faile
     if inliers is not None and labels is not None:
         res["inliers"] = inlier_precision_recall(inliers, labels)
     return res
+
+
+#: The match set whose estimate is the method's own from the images (OpenCV's SIFT matches of the
+#: two images): its headline metrics carry no set name, so a method that estimates from the images
+#: itself (``run --command --kind fmatrix`` with ``{images}``, ``recon-eval fmatrix``) shares their
+#: leaderboard columns and gates; the labelled synthetic set's carry ``synthetic.``.
+IMAGES_SET = "sift"
+
+
+def headline_prefix(i: str, j: str, kind: str, n_pairs: int) -> str:
+    """The prefix of a match set's headline metrics: ``<set>.`` (none for :data:`IMAGES_SET`), with
+    ``<i>__<j>.`` in front when the dataset has several pairs."""
+    pair = "" if n_pairs == 1 else f"{i}__{j}."
+    return pair if kind == IMAGES_SET else f"{pair}{kind}."
+
+
+#: The headline metric names of an F (the ``metrics`` keys of every F method's run and of
+#: ``recon-eval fmatrix --json``), each with the result group and field it comes from.
+HEADLINE = {"sampson_rms_px": ("fundamental", "sampson_rms_px"), "pose_err_deg": ("pose_via_K", "pose_err_deg"),
+            "f_distance_px": ("zhang_f_distance", "f_distance_px"), "inlier_recall": ("inliers", "recall"),
+            "inlier_precision": ("inliers", "precision")}
+
+
+def headline(res: dict, prefix: str = "") -> dict:
+    """The headline metrics of an F's result groups (``score_pair``'s, or a run's groups of one
+    match set), named by :data:`HEADLINE` with ``prefix`` in front: one name per number for the
+    runs, the scoring command and the gates (docs/ci.md, "Metric paths")."""
+    out = {}
+    for name, (group, field) in HEADLINE.items():
+        if group in res:
+            r = res[group]
+            out[prefix + name] = r[field] if isinstance(r, dict) else getattr(r, field)
+    return out
+
+
+def unusable_f_warning(fundamental_result, item: str) -> str | None:
+    """The warning for an estimate that cannot be scored (``fundamental_metrics`` failed: a
+    non-finite, zero or rank-3 F is scored as a failure, every error inf), naming ``item`` (the
+    pair, and the match set); None for a usable F."""
+    if not fundamental_result.failed:
+        return None
+    return (f"{item}: the estimated F is {fundamental_result.failure_reason}: scored as a failed estimate "
+            f"(sampson_rms_px inf)")

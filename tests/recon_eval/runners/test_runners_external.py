@@ -170,6 +170,20 @@ def test_external_disparity_is_scored_as_the_builtin(tmp_path):
     assert res.notes["cam_l"]["failed"] == "exit status 1" and res.metrics["invalid_noc_pct"] == 100.0
 
 
+def test_external_disparity_of_the_wrong_sign_is_hinted(tmp_path, capsys):
+    """The command writes the negated truth: ~100 % bad, and a warning naming the method and frame."""
+    frame = _Frame(tmp_path)
+    np.save(tmp_path / "neg.npy", -frame.disp)
+    tool = tmp_path / "neg.py"
+    tool.write_text("import sys, numpy as np\nfrom scenegen.dataset.codecs import write_pfm\n"
+                    f"write_pfm(sys.argv[1], np.load({str(tmp_path / 'neg.npy')!r}))\n")
+    m = external_method("neg-stereo", "disparity", f"{{python}} {tool} {{out}}")
+    res = external.disparity(frame, tmp_path / "run", dict(m.options))
+    assert res.metrics["bad_2_0_noc_pct"] > 99.0
+    assert len(res.warnings) == 1 and res.warnings[0].startswith("cam_l (non-occluded): ")
+    assert "is its sign reversed?" in res.warnings[0]
+
+
 # --- on a rendered scene ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def wide(tmp_path_factory):
@@ -212,6 +226,9 @@ def test_docs_worked_example_runs_as_written(wide, tmp_path, monkeypatch, capsys
     board = json.loads((tmp_path / "board/leaderboard.json").read_text())
     assert [r["inputs"]["method"] for r in board["runs"]] == ["my-fmatrix", "my-f-matches", "opencv-f-ransac"]
     assert {r["inputs"]["task"] for r in board["runs"]} == {"fundamental matrix"}  # one table on the page
+    # the estimate from the images shares its columns with OpenCV's (its SIFT set): ranked, not starred alone
+    shared = {"sampson_rms_px", "pose_err_deg", "f_distance_px"}
+    assert all(shared <= set(r["metrics"]) for r in board["runs"])
     page = (tmp_path / "board/leaderboard.html").read_text()
     assert page.count("<h2>fundamental matrix</h2>") == 1 and 'href="wide_baseline/my-fmatrix/report.html"' in page
     report = (tmp_path / "board/wide_baseline/my-fmatrix/report.html").read_text()
@@ -282,6 +299,11 @@ def test_external_sfm_model_is_scored_as_pycolmap(plane_dataset, tmp_path):
     met = doc["metrics"]
     assert met["registration_ratio"] == 1.0 and met["max_rot_err_deg"] < 1e-6 and met["n_points3d"] == 4
     assert met["cloud_precision_at_1cm"] == 0.75
+    # the same model scored by hand: the same numbers under the same names (one gate file for both)
+    assert main(["poses", str(tmp_path / "run" / "model"), str(root), "--json", str(tmp_path / "p.json"), "-q"]) == 0
+    by_hand = json.loads((tmp_path / "p.json").read_text())["metrics"]
+    shared = ("registration_ratio", "max_rot_err_deg", "median_rot_err_deg")
+    assert {k: by_hand[k] for k in shared} == {k: met[k] for k in shared}
     assert doc["inputs"]["raw_files"] == ["model/cameras.txt", "model/images.txt", "model/points3D.txt"]
     _colmap_text_model(tmp_path / "two", cams, ["left_000", "right_000"], pts)
     tool.write_text(f"import shutil, sys\nshutil.copytree({str(tmp_path / 'two')!r}, sys.argv[2], dirs_exist_ok=True)\n")
@@ -313,6 +335,11 @@ def test_external_calibration_is_scored_as_the_builtin(plane_dataset, tmp_path):
     assert met["left.fx_rel_err"] == 0 and met["right.proj_diff_rms_px"] < 1e-9
     assert met["free.fx_rel_err"] == pytest.approx(0.5 / cams["free_000"][0].fx, abs=1e-15)
     assert "free.calib_rms_px" not in met and doc["inputs"]["task"] == "calibration"
+    # the same file scored by hand: the run's names without the camera prefix, the same numbers
+    assert main(["calibration", str(tmp_path / "run" / "calibration_free.yaml"), str(root), "--view", "free_000",
+                 "--json", str(tmp_path / "c.json"), "-q"]) == 0
+    by_hand = json.loads((tmp_path / "c.json").read_text())["metrics"]
+    assert by_hand == {k.removeprefix("free."): v for k, v in met.items() if k.startswith("free.")}
     assert sorted(doc["inputs"]["raw_files"]) == ["calibration_free.yaml", "calibration_left.yaml",
                                                    "calibration_right.yaml"]
 
@@ -346,3 +373,19 @@ def test_leaderboard_with_declared_methods_and_gates(plane_dataset, tmp_path, ca
     (line,) = out.splitlines()
     assert line.startswith("FAIL n_points3d = 1, threshold >= 100"), out
     assert (tmp_path / "q" / "leaderboard.html").is_file()
+
+
+@pytest.mark.render
+def test_external_homography_kind_on_the_planes(wide, tmp_path):
+    """The truth H of each plane: MACE 0 under the built-in H methods' names; transposed: large."""
+    est = ROOT / "tests" / "recon_eval" / "runners" / "estimators" / "true_homography.py"
+    cmd = f"{{python}} {est} {{dataset}} {{view1}} {{view2}} {{plane}} {{out}}"
+    doc = run_method("my-h", wide, tmp_path / "h", declared={"my-h": external_method("my-h", "homography", cmd)})
+    ref = run_method("opencv-h-usac-magsac", wide, tmp_path / "ref")
+    planes = {k for k in ref["metrics"] if not k.startswith("synthetic.")}  # the estimate from the images
+    assert set(doc["metrics"]) >= planes and doc["inputs"]["task"] == ref["inputs"]["task"] == "homography"
+    assert all(v < 1e-6 for v in doc["metrics"].values())
+    bad = run_method("my-h-t", wide, tmp_path / "t",
+                     declared={"my-h-t": external_method("my-h-t", "homography", cmd + " --transpose")})
+    assert all(v > 10 for v in bad["metrics"].values())
+

@@ -287,3 +287,16 @@ def test_zero_baseline_pairs_are_not_triangulated(tmp_path, capsys, zero_baselin
     r = run_method("opencv-triangulate", tmp_path / "ds", tmp_path / "run")
     assert r["inputs"]["notes"]["skipped_zero_baseline_pairs"] == ["cam_0000:cam_0001"]
     assert r["metrics"]["sigma0.max_rel_err"] < NOISE_FREE_REL_TOL
+
+
+@pytest.mark.render
+def test_external_dlt_kind_equals_dlt_linear(runs, scenes, tmp_path):
+    """The same DLT as a user's script on the {points} files: dlt-linear's numbers under its names."""
+    from recon_eval.runners import run_method
+    from recon_eval.runners.declared import external_method
+
+    est = Path(__file__).resolve().parent / "estimators" / "linear_dlt.py"
+    m = external_method("my-dlt", "dlt", f"{{python}} {est} {{points}} {{out}}")
+    doc = run_method("my-dlt", scenes["dlt"], tmp_path / "mine", declared={"my-dlt": m})
+    ref = runs["dlt"][1]
+    assert doc["inputs"]["task"] == ref["inputs"]["task"] and doc["metrics"] == ref["metrics"]

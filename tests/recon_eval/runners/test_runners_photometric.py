@@ -139,3 +139,28 @@ def test_near_light_runner_beats_the_plane_and_distant_approximations(tmp_path):
     # measured: 0.164 deg after 4 rounds, 1.03 deg with every pixel on the start plane, 14.3 deg
     # with distant lights taken at the object's centre
     assert m["lambertian.mean_ae_deg"] < 0.3 < 0.5 < m["plane.mean_ae_deg"] < 5.0 < m["distant.mean_ae_deg"]
+
+
+@pytest.mark.render
+def test_external_normals_kind_and_recon_eval_normals_agree(ps_dataset, tmp_path):
+    """A user's method given the set's images, lights and mask: the truth normals score 0 deg under
+    woodham-ps's names; ``recon-eval normals --json`` on the same file gives the same headline."""
+    import json
+    from pathlib import Path
+
+    from recon_eval.cli import main
+    from recon_eval.runners.declared import external_method
+
+    est = Path(__file__).resolve().parent / "estimators" / "true_normals.py"
+    m = external_method("my-ps", "normals", f"{{python}} {est} {{dataset}} {{out}} {{images}}")
+    doc = run_method("my-ps", ps_dataset, tmp_path / "mine", declared={"my-ps": m})
+    ref = run_method("woodham-ps", ps_dataset, tmp_path / "ref")
+    names = {k for k in ref["metrics"] if k.endswith(("_ae_deg", "within_10deg"))}
+    assert set(doc["metrics"]) == names and doc["inputs"]["task"] == ref["inputs"]["task"]
+    # float32 truth: |n|^2 = 1 +- ~2.4e-7, and DiLiGenT's acos(dot) without normalising turns that into up to
+    # sqrt(2 * 2.4e-7) rad = 0.04 deg a pixel
+    assert doc["metrics"]["all.mean_ae_deg"] < 0.04 and doc["metrics"]["all.within_10deg"] == 1.0
+    out = tmp_path / "n.json"
+    assert main(["normals", str(tmp_path / "mine" / "ps" / "normals.npy"), str(ps_dataset), "--json", str(out),
+                 "-q"]) == 0
+    assert json.loads(out.read_text())["metrics"] == pytest.approx(doc["metrics"], abs=1e-12)

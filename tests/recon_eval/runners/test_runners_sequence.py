@@ -2,6 +2,7 @@
 predictions (values worked by hand), the LK track baseline and DIS flow as methods (the flow's
 truth and occlusion states from the sequence's motion truth, moving objects included)."""
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,3 +97,61 @@ def test_lk_tracks_and_dis_flow_run_as_methods(sequence, tmp_path):
     assert both.sum() > 1000 and np.abs(flow[both] - flo[both]).max() < 1e-4
     doc = run_method("opencv-flow-dis", sequence, tmp_path / "dis")
     assert np.isfinite(doc["metrics"]["epe_noc_px"]) and np.isfinite(doc["metrics"]["epe_all_px"])
+
+
+EST = Path(__file__).resolve().parent / "estimators"
+
+
+def _external(name, kind, command, sequence, out):
+    from recon_eval.runners.declared import external_method
+
+    return run_method(name, sequence, out, declared={name: external_method(name, kind, command)})
+
+
+def test_external_tracks_kind_equals_the_builtin_lk(sequence, tmp_path):
+    mine = _external("my-lk", "tracks", f"{{python}} {EST / 'lk_tracks.py'} {{queries}} {{out}} {{images}}", sequence,
+                     tmp_path / "mine")
+    ref = run_method("opencv-lk-tapvid", sequence, tmp_path / "ref")
+    assert mine["metrics"] == ref["metrics"] and mine["inputs"]["task"] == ref["inputs"]["task"]
+    assert set(mine["metrics"]) == {"average_jaccard", "average_pts_within", "occlusion_accuracy"}
+
+
+ARC = """
+name: arc
+render: {spp: 4, max_depth: 2}
+sequence: {fps: 10, frames: 5}
+objects:
+  - {name: floor, shape: {type: plane, size: [3, 3]}, material: {type: diffuse, texture: {type: noise}}}
+lights: [{type: constant, radiance: 1}]
+cameras:
+  cam: {size: [32, 24], fx: 28}
+views:
+  - camera: cam
+    trajectory:
+      keyframes:
+        - {time_s: 0.0, eye: [0, -2, 1.8], target: [0, 0, 0]}
+        - {time_s: 0.2, eye: [0.6, -1.8, 1.6], target: [0, 0, 0]}
+        - {time_s: 0.4, eye: [1.0, -1.2, 1.9], target: [0, 0, 0]}
+"""
+
+
+def test_external_trajectory_kind_and_recon_eval_poses_agree(sequence, tmp_path):
+    """The truth trajectory scaled by 2: APE 0 after Sim(3), every frame registered; the TUM export's
+    groundtruth against the same file with ``recon-eval poses --json``: the same numbers, same names.
+    A straight truth path (the module's sequence) cannot anchor Sim(3): not applicable, said."""
+    cmd = f"{{python}} {EST / 'true_trajectory.py'} {{dataset}} {{times}} {{out}} 2"
+    from recon_eval.errors import NotApplicable
+    with pytest.raises(NotApplicable, match="cannot anchor a Sim"):
+        _external("my-vo", "trajectory", cmd, sequence, tmp_path / "line")
+    (tmp_path / "arc.yaml").write_text(ARC)
+    sequence = tmp_path / "arc"
+    assert scenegen_main(["render", str(tmp_path / "arc.yaml"), "-o", str(sequence), "-q"]) == 0
+    doc = _external("my-vo", "trajectory", cmd, sequence, tmp_path / "vo")
+    m = doc["metrics"]
+    assert m["registration_ratio"] == 1.0 and m["max_rot_err_deg"] < 1e-5 and m["ape_trans_rmse_m"] < 1e-6
+    assert doc["inputs"]["task"] == "camera trajectory"
+    assert scenegen_main(["export", str(sequence), "--format", "tum", "-o", str(tmp_path / "tum"), "-q"]) == 0
+    gt = next((tmp_path / "tum").glob("*/groundtruth.txt"))
+    est = next((tmp_path / "vo").glob("*/trajectory.txt"))
+    assert recon_main(["poses", str(est), str(gt), "--json", str(tmp_path / "p.json"), "-q"]) == 0
+    assert json.loads((tmp_path / "p.json").read_text())["metrics"] == pytest.approx(m, abs=1e-9)
