@@ -34,6 +34,7 @@ from scenegen.dataset.crossview_reader import TwoViewTruth
 from scenegen.dataset.codecs import TrackSet
 from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, SEQUENCE_INDEX, correspondence_path,
                                      flow_path, mesh_path, motion_path, stereo_path, twoview_path, view_paths)
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.conventions import in_image
 from scenegen.geometry.twoview import fundamental
 
@@ -186,7 +187,7 @@ class DatasetTruth:
 
     def object_ids(self, view: str) -> np.ndarray:
         """(H, W) uint32 object id of each pixel centre's hit (spec object k is k + 1; 0 = none)."""
-        return self._read(self._ds.truth, self.check_view(view))["object_id"]
+        return self._read(self._ds.truth, self.check_view(view))[TruthKind.OBJECT_ID]
 
     def disparity(self, left: str, right: str | None = None) -> np.ndarray:
         """Truth disparity (H, W) float64 px of the rectified pair (left, right):

@@ -36,6 +36,7 @@ from scenegen.dataset.layout import (
     twoview_path,
     view_targets_path,
 )
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
 
@@ -134,11 +135,11 @@ class StereoFrame:
 
     def instance_ids(self, side: str) -> np.ndarray:
         """(H, W) uint32 instance id of the surface each rectified pixel centre sees (0 = none)."""
-        return self._read("ids", side, read_exr, "ids")["instance_id"]
+        return self._read("ids", side, read_exr, "ids")[TruthKind.INSTANCE_ID]
 
     def object_ids(self, side: str) -> np.ndarray:
         """(H, W) uint32 object id of the surface each rectified pixel centre sees (0 = none)."""
-        return self._read("ids", side, read_exr, "ids")["object_id"]
+        return self._read("ids", side, read_exr, "ids")[TruthKind.OBJECT_ID]
 
 
 class CrossviewTruth:

@@ -49,7 +49,7 @@ from scenegen.dataset.photometric import ViewLight, decode_albedo, decode_lights
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.sequence_reader import SequenceTruth
 from scenegen.dataset.stream_reader import Streams
-from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
+from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, TruthKind, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
 
@@ -219,11 +219,11 @@ class Dataset:
 
     def depth_z(self, view: str) -> np.ndarray:
         """(H, W) float32 z-depth, metres; +inf where the ray hit nothing."""
-        return self._truth_channel(view, "depth_z")
+        return self._truth_channel(view, TruthKind.DEPTH_Z)
 
     def points_world(self, view: str) -> np.ndarray:
         """(H, W, 3) float32 world points, metres; NaN where the ray hit nothing."""
-        return self._truth_channel(view, "points_world")
+        return self._truth_channel(view, TruthKind.POINTS_WORLD)
 
     def _truth_channel(self, view: str, key: str) -> np.ndarray:
         prefix, comps = TRUTH_FLOAT_CHANNELS[key]
