@@ -30,6 +30,7 @@ from recon_eval.metrics.epipolar import (fundamental_metrics, homography_mace, i
                                          pose_error_from_fundamental, sampson_sq_px2, zhang_f_distance)
 from recon_eval.metrics.poses import relative_pose_errors_deg
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.twoview import undistorted_pixels
 
 #: RANSAC-family thresholds, px. FM_RANSAC thresholds the larger point-to-epipolar-line distance
@@ -85,7 +86,7 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
     out = RunOutput()
     for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
-        tv = ds.twoview(i, j)
+        tv = ds.read(ds.dataset.crossview.twoview, i, j)
         if tv.F is None:  # one camera centre (crossview.md): F and E do not exist
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
@@ -151,7 +152,7 @@ def essential(ds, out_dir, options) -> RunOutput:
     for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
         rel = pj @ pi.inverse()
-        if ds.twoview(i, j).E is None:
+        if ds.read(ds.dataset.crossview.twoview, i, j).E is None:
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
         for ms in ds.match_sets(i, j):
@@ -195,10 +196,10 @@ def homography(ds, out_dir, options) -> RunOutput:
     for i, j in pairs:
         ci, _ = ds.camera(i)
         cj, _ = ds.camera(j)
-        planes = ds.twoview(i, j).homographies
+        planes = ds.read(ds.dataset.crossview.twoview, i, j).homographies
         if not planes:
             continue
-        obj_i = ds.object_ids(i)
+        obj_i = ds.truth(i)[TruthKind.OBJECT_ID]
         for ms in ds.match_sets(i, j):
             kind = ms.kind
             ui = np.clip(np.rint(ms.column("u_i")).astype(int), 0, ci.width - 1)

@@ -194,6 +194,10 @@ class Dataset:
         """The rendered image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16."""
         return self.read(self._view_file(view, "image"), read_png, f"image of view {view!r}")
 
+    def image_path(self, view: str) -> Path:
+        """The rendered image's file (images/<view>.png), for tools that read files."""
+        return self.path(self._view_file(view, "image"))
+
     def linear_image(self, view: str) -> np.ndarray:
         """Clean linear radiance, (H, W, 3) float32 RGB."""
         ch = self.read(self._view_file(view, "linear"), read_exr, f"linear image of view {view!r}")
