@@ -31,9 +31,8 @@ from scenegen.dataset import CAMERAS, MANIFEST, Dataset, DatasetError
 from scenegen.dataset.crossview import VISIBLE, Correspondence, CrossviewIndex, MatchSet
 from scenegen.dataset.codecs import TrackSet
 from scenegen.dataset.layout import (CROSSVIEW_INDEX, MATCH_KINDS, MESHES_DIR, SEQUENCE_INDEX, correspondence_path,
-                                     flow_path, mesh_path, motion_path, stereo_path, twoview_path, view_paths)
+                                     flow_path, mesh_path, stereo_path, view_paths)
 from scenegen.geometry.conventions import in_image
-from scenegen.geometry.twoview import fundamental
 
 #: Rectification tolerances of :meth:`DatasetTruth.disparity`: rotations equal to 1e-9 (JSON
 #: round-trips float64 exactly; the renderer places both members by the same rig rotation), and
@@ -276,46 +275,23 @@ class DatasetTruth:
 
     def flow_truth(self, view1: str, view2: str):
         """``(flow (H, W, 2) float64 px, states (H, W) uint8 or None, source)`` of view1 -> view2:
-        a sequence's motion truth of the pair (flow and occlusion states at view2's time), else
-        the dataset's flow file when it has one (consecutive frames), else the correspondence
-        field ``uv - pixel`` of a crossview pair; the occlusion states from the correspondence file
-        when the dataset has it (None otherwise). NaN where the flow is unknown."""
-        self.check_view(view1)
-        self.check_view(view2)
-        if self.dataset.has(motion_path(view1, view2)):  # a sequence's frame pair, moving objects too
-            m = self.read(self.dataset.sequence.motion, view1, view2)
-            flow = np.array(m.flow, dtype=np.float64)
-            flow[~np.all(np.isfinite(flow), axis=2)] = np.nan
-            return flow, m.state, str(motion_path(view1, view2))
-        has_corr = self.dataset.crossview.has_correspondence(view1, view2)
-        corr = self.read(self.dataset.crossview.correspondence, view1, view2) if has_corr else None
-        if self.dataset.has(flow_path(view1, view2)):
-            flow = self.read(self.dataset.crossview.flow, view1, view2).astype(np.float64)
-            source = str(flow_path(view1, view2))
-        elif corr is not None:
-            H, W = corr.shape
-            grid = np.stack(np.meshgrid(np.arange(W, dtype=np.float64), np.arange(H, dtype=np.float64)), -1)
-            flow, source = corr.uv - grid, str(correspondence_path(view1, view2)) + " (uv - pixel)"
-        else:
-            raise NotApplicable(f"{self.dataset.path(flow_path(view1, view2))}: no such file, and no correspondence truth "
-                                f"for views {view1!r} -> {view2!r}: the dataset holds no flow for this pair")
+        the flow truth the dataset holds for the pair (:meth:`scenegen.dataset.crossview_reader.
+        CrossviewTruth.pair_flow`), NaN where the flow is unknown; NotApplicable when it holds none."""
+        found = self.read(self.dataset.crossview.pair_flow, self.check_view(view1), self.check_view(view2))
+        if found is None:
+            raise NotApplicable(f"{self.dataset.path(flow_path(view1, view2))}: no such file, and no correspondence "
+                                f"truth for views {view1!r} -> {view2!r}: the dataset holds no flow for this pair")
+        flow, states, source = found
+        flow = np.array(flow, dtype=np.float64)
         flow[~np.all(np.isfinite(flow), axis=2)] = np.nan
-        return flow, None if corr is None else corr.state, source
+        return flow, states, source
 
     def truth_fundamental(self, view1: str, view2: str):
-        """``(F (3, 3) or None, source)``: the truth F of view1 -> view2 for UNDISTORTED OpenCV pixels,
-        the stored ``crossview/twoview/<i>/<j>.json`` when the dataset has it, else
-        ``K2^-T [t]x R K1^-1`` of cameras.json; None for a zero baseline (one camera centre)."""
-        self.check_view(view1)
-        self.check_view(view2)
-        if self.dataset.has(twoview_path(view1, view2)):
-            tv = self.read(self.dataset.crossview.twoview, view1, view2)
-            return tv.F, str(twoview_path(view1, view2))
-        (c1, p1), (c2, p2) = self.camera(view1), self.camera(view2)
-        rel = p2 @ p1.inverse()
-        if np.linalg.norm(rel.t) == 0.0:
-            return None, f"{CAMERAS}: one camera centre"
-        return fundamental(c1.K, c2.K, rel), f"{CAMERAS}: K2^-T [t]x R K1^-1"
+        """``(F (3, 3) or None, source)``: the truth F of view1 -> view2 for UNDISTORTED OpenCV pixels
+        (:meth:`scenegen.dataset.crossview_reader.CrossviewTruth.fundamental`)."""
+        for view in (view1, view2):
+            self.camera(view)  # the view and its camera checked, with the evaluator's errors
+        return self.read(self.dataset.crossview.fundamental, view1, view2)
 
     def stereo_image_path(self, left_view: str, side: str) -> Path:
         """The rectified image file of one side of a stereo frame (for tools that read files)."""
