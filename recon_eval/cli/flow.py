@@ -15,7 +15,6 @@ from recon_eval.readers.flow import FLOW_SUFFIXES, read_flow
 from recon_eval.readers.kitti_png import read_kitti_obj_map
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
 from scenegen.dataset.crossview import OCCLUDED, VISIBLE
-from scenegen.dataset.truth import TruthKind
 
 
 def arguments(p) -> None:
@@ -62,7 +61,7 @@ def _dataset_pairs(a, ds):
             e = read_flow(a.est)
         if e.shape != g.shape:
             raise InputError(f"{a.est}: flow shape {e.shape} differs from the truth's {g.shape} ({i} -> {j})")
-        fg = np.isin(ds.truth(i)[TruthKind.OBJECT_ID], fg_ids) if fg_ids else None
+        fg = np.isin(ds.object_ids(i), fg_ids) if fg_ids else None
         out.append((e, g, st, fg, (i, j), source))
     return out, missing
 

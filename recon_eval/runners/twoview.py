@@ -30,7 +30,6 @@ from recon_eval.metrics.epipolar import (fundamental_metrics, homography_mace, i
                                          pose_error_from_fundamental, sampson_sq_px2, zhang_f_distance)
 from recon_eval.metrics.poses import relative_pose_errors_deg
 from recon_eval.runners.common import RunOutput, crossview_pairs, out_path
-from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.twoview import undistorted_pixels
 
 #: RANSAC-family thresholds, px. FM_RANSAC thresholds the larger point-to-epipolar-line distance
@@ -199,7 +198,7 @@ def homography(ds, out_dir, options) -> RunOutput:
         planes = ds.read(ds.dataset.crossview.twoview, i, j).homographies
         if not planes:
             continue
-        obj_i = ds.truth(i)[TruthKind.OBJECT_ID]
+        obj_i = ds.object_ids(i)
         for ms in ds.match_sets(i, j):
             kind = ms.kind
             ui = np.clip(np.rint(ms.column("u_i")).astype(int), 0, ci.width - 1)

@@ -229,6 +229,11 @@ class Dataset:
         """(H, W, 3) float32 world points, metres; NaN where the ray hit nothing."""
         return self._truth_channel(view, TruthKind.POINTS_WORLD)
 
+    def object_ids(self, view: str) -> np.ndarray:
+        """(H, W) uint32 object id of each pixel centre's hit (spec object k is k + 1; 0 = none)."""
+        return self.read(self._view_file(view, "ids"), lambda p: read_exr(p)[TruthKind.OBJECT_ID],
+                         f"object ids of view {view!r}")
+
     def _truth_channel(self, view: str, key: str) -> np.ndarray:
         prefix, comps = TRUTH_FLOAT_CHANNELS[key]
         ch = self.truth_channels(view)
