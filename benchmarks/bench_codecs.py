@@ -36,7 +36,7 @@ def main(argv=None) -> int:
     import cv2
     import OpenEXR
 
-    from scenegen.dataset.truth import TRUTH_ID_KEYS, check_truth, truth_float_channels
+    from scenegen.dataset.truth import check_truth, truth_float_channels, truth_id_channels
     from scenegen.pipeline.view import render_view_data
     from scenegen.render import load_scene
     from scenegen.spec import load_spec, resolve_views
@@ -46,7 +46,7 @@ def main(argv=None) -> int:
     built = load_scene(spec)
     image, linear, truth, _ = render_view_data(spec, built, 1, view, spp=spec.render.spp, seed=spec.render.seed)
     t = check_truth(truth)
-    truth_ch = {**truth_float_channels(t), **{k: t[k] for k in TRUTH_ID_KEYS}}
+    truth_ch = {**truth_float_channels(t), **truth_id_channels(t)}
     rgb_ch = {c: np.ascontiguousarray(linear[..., i]) for i, c in enumerate("RGB")}
 
     def encode(chans, comp):

@@ -115,8 +115,9 @@ SCENEGEN_LAYERS = {
     "scenegen.spec": ("scenegen.errors", "scenegen.located_yaml", "scenegen.geometry", "scenegen.assets",
                       "scenegen.imaging"),
     # the renderer implements the dataset's visibility rule (dataset.crossview.OCCLUSION_REL_TOL)
+    # and casts the truth kinds the dataset stores (dataset.truth.TruthKind)
     "scenegen.render": ("scenegen.errors", "scenegen.geometry", "scenegen.assets", "scenegen.spec",
-                        "scenegen.dataset.crossview"),
+                        "scenegen.dataset.crossview", "scenegen.dataset.truth"),
     "scenegen.export": ("scenegen.geometry", "scenegen.dataset"),
     # the preview composes its sheet with the gallery's code (scenegen.export.sheet), the layer below
     "scenegen.pipeline": ("scenegen.errors", "scenegen.geometry", "scenegen.dataset", "scenegen.assets",

@@ -16,6 +16,7 @@ from recon_eval.readers.scenegen_dataset import is_dataset
 from recon_eval.tasks.headlines import normals_headline
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.conventions import DILIGENT_FROM_OPENCV_CAM
 
 FRAMES = ("diligent", "opencv")
@@ -60,7 +61,7 @@ def score(a):
     except (DatasetError, KeyError) as exc:
         raise InputError(f"{a.gt}: {exc.args[0]}" if isinstance(exc, KeyError) else str(exc)) from None
     est = read_normal_map(a.est)
-    gt_n = truth["normals_cam"].astype(np.float64)
+    gt_n = truth[TruthKind.NORMALS_CAM].astype(np.float64)
     if est.shape != gt_n.shape:
         raise InputError(f"{a.est}: normal map shape {est.shape} differs from view {view!r}'s {gt_n.shape}")
     if a.normalize:
@@ -72,8 +73,8 @@ def score(a):
     if unknown:
         raise InputError(f"--object {unknown[0]!r}: not an object of the dataset (objects: {', '.join(ids)})")
     names = a.objects or list(ids)
-    groups = {"all": np.isin(truth["object_id"], [ids[n] for n in names]), **{n: truth["object_id"] == ids[n]
-                                                                                for n in names}}
+    object_id = truth[TruthKind.OBJECT_ID]
+    groups = {"all": np.isin(object_id, [ids[n] for n in names]), **{n: object_id == ids[n] for n in names}}
     res = {}
     for name, m in groups.items():
         if m.any():

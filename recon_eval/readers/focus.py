@@ -11,6 +11,7 @@ import numpy as np
 from recon_eval.errors import InputError, NotApplicable
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import linear_from_srgb
 
 
@@ -73,7 +74,7 @@ def _grey(img: np.ndarray) -> np.ndarray:
 def _stack(ds: Dataset, members) -> FocusStack:
     views = tuple(v for _, v, _ in members)
     truth = ds.truth(views[0])
-    depth = truth["depth_z"].astype(np.float64)
+    depth = truth[TruthKind.DEPTH_Z].astype(np.float64)
     depth[~np.isfinite(depth)] = np.nan
     cocs = [ds.coc_radius_px(v) for v in views]
     fx = float(ds.camera(views[0])[0].fx)
@@ -82,6 +83,7 @@ def _stack(ds: Dataset, members) -> FocusStack:
         f_number=np.array([lens["f_number"] for _, _, lens in members]),
         blur_px_per_dioptre=np.array([fx * fx * lens["pixel_pitch_um"] * 1e-6 / (2 * lens["f_number"])
                                       for _, _, lens in members]),
-        images_linear=np.stack([_grey(ds.image(v)) for v in views]), depth_z=depth, object_id=truth["object_id"],
+        images_linear=np.stack([_grey(ds.image(v)) for v in views]), depth_z=depth,
+        object_id=truth[TruthKind.OBJECT_ID],
         coc_radius_px=None if any(c is None for c in cocs) else np.stack(cocs),
         objects={o["name"]: int(o["object_id"]) for o in ds.objects})

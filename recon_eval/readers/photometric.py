@@ -13,6 +13,7 @@ import numpy as np
 from recon_eval.errors import InputError, NotApplicable
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import linear_from_srgb
 
 
@@ -78,7 +79,7 @@ def _stack(ds: Dataset, members) -> PhotometricSet:
         if img.ndim == 2:
             img = np.repeat(img[..., None], 3, axis=2)
         images.append(linear_from_srgb(img / float(np.iinfo(img.dtype).max)))
-    depth = truth["depth_z"].astype(np.float64)
+    depth = truth[TruthKind.DEPTH_Z].astype(np.float64)
     depth[~np.isfinite(depth)] = np.nan
     cam, _ = _read(ds.camera, first)
     lights = [li for _, li in members]
@@ -89,6 +90,7 @@ def _stack(ds: Dataset, members) -> PhotometricSet:
                       for li in lights], np.float64)
     return PhotometricSet(
         views=views, images_linear=np.stack(images), directions_cam=dirs, intensities=inten, positions_cam=pos,
-        normals_cam=truth["normals_cam"].astype(np.float64), albedo=None if albedo is None else albedo.astype(np.float64),
-        depth_z=depth, object_id=truth["object_id"], fx_px=float(cam.fx), camera=cam,
+        normals_cam=truth[TruthKind.NORMALS_CAM].astype(np.float64),
+        albedo=None if albedo is None else albedo.astype(np.float64),
+        depth_z=depth, object_id=truth[TruthKind.OBJECT_ID], fx_px=float(cam.fx), camera=cam,
         objects={o["name"]: int(o["object_id"]) for o in ds.objects})

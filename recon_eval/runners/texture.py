@@ -29,6 +29,7 @@ from recon_eval.readers.rows import read_rows
 from recon_eval.runners.common import RunOutput, out_path
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import linear_from_srgb
 
 
@@ -64,15 +65,15 @@ def structure_tensor(ds, out_dir, options) -> RunOutput:
         views, normals, truths = [], [], []
         for v in d.views:
             t = d.truth(v)
-            ids = np.unique(t["object_id"][t["valid"]])
-            n = t["normals_cam"][t["valid"]].astype(np.float64)
+            ids = np.unique(t[TruthKind.OBJECT_ID][t[TruthKind.VALID]])
+            n = t[TruthKind.NORMALS_CAM][t[TruthKind.VALID]].astype(np.float64)
             if len(ids) != 1 or len(n) < 100 or np.abs(n - n[0]).max() > 1e-3:
                 continue  # not one plane
             img = np.asarray(d.image(v))
             grey = linear_from_srgb(img / float(np.iinfo(img.dtype).max))
             grey = grey.mean(axis=-1) if grey.ndim == 3 else grey
             views.append(v)
-            normals.append(plane_normal_from_texture(grey, t["valid"], window))
+            normals.append(plane_normal_from_texture(grey, t[TruthKind.VALID], window))
             truths.append(n.mean(axis=0))
     except DatasetError as exc:
         raise InputError(str(exc)) from None

@@ -86,7 +86,7 @@ def fundamental(ds, out_dir, options, *, transform_F: Callable[[np.ndarray], np.
     out = RunOutput()
     for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
-        tv = ds.twoview(i, j)
+        tv = ds.read(ds.dataset.crossview.twoview, i, j)
         if tv.F is None:  # one camera centre (crossview.md): F and E do not exist
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
@@ -159,7 +159,7 @@ def essential(ds, out_dir, options) -> RunOutput:
     for i, j in pairs:
         (ci, pi), (cj, pj) = ds.camera(i), ds.camera(j)
         rel = pj @ pi.inverse()
-        if ds.twoview(i, j).E is None:
+        if ds.read(ds.dataset.crossview.twoview, i, j).E is None:
             out.notes[f"{i}__{j}"] = ZERO_BASELINE_NOTE
             continue
         for ms in ds.match_sets(i, j):
@@ -203,7 +203,7 @@ def homography(ds, out_dir, options) -> RunOutput:
     for i, j in pairs:
         ci, _ = ds.camera(i)
         cj, _ = ds.camera(j)
-        planes = ds.twoview(i, j).homographies
+        planes = ds.read(ds.dataset.crossview.twoview, i, j).homographies
         if not planes:
             continue
         obj_i = ds.object_ids(i)

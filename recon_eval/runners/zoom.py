@@ -29,6 +29,7 @@ from recon_eval.readers.rows import read_rows
 from recon_eval.runners.common import RunOutput, out_path
 from scenegen.dataset import Dataset
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import to_grey8
 
 
@@ -91,7 +92,7 @@ def radial(ds, out_dir, options) -> RunOutput:
             for (u, w), zz in zip(x1, z):
                 if np.isfinite(zz):
                     per_point.setdefault((round(u, 3), round(w, 3)), []).append(zz)
-        depth_gt = d.truth(v1)["depth_z"].astype(np.float64)
+        depth_gt = d.truth(v1)[TruthKind.DEPTH_Z].astype(np.float64)
     except DatasetError as exc:
         raise InputError(str(exc)) from None
     rel = "zoom/points.txt"

@@ -27,17 +27,21 @@ from scenegen.dataset.crossview import (
 )
 from scenegen.dataset.errors import DatasetError
 from scenegen.dataset.layout import (
+    CAMERAS,
     CROSSVIEW_INDEX,
     STEREO_SIDES,
     correspondence_path,
     flow_path,
     matches_path,
+    motion_path,
     stereo_path,
     twoview_path,
     view_targets_path,
 )
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
+from scenegen.geometry.twoview import fundamental
 
 _NO_INDEX = "render the spec with a `crossview:` section (docs/scene_spec.md)"
 
@@ -134,11 +138,11 @@ class StereoFrame:
 
     def instance_ids(self, side: str) -> np.ndarray:
         """(H, W) uint32 instance id of the surface each rectified pixel centre sees (0 = none)."""
-        return self._read("ids", side, read_exr, "ids")["instance_id"]
+        return self._read("ids", side, read_exr, "ids")[TruthKind.INSTANCE_ID]
 
     def object_ids(self, side: str) -> np.ndarray:
         """(H, W) uint32 object id of the surface each rectified pixel centre sees (0 = none)."""
-        return self._read("ids", side, read_exr, "ids")["object_id"]
+        return self._read("ids", side, read_exr, "ids")[TruthKind.OBJECT_ID]
 
 
 class CrossviewTruth:
@@ -198,6 +202,19 @@ class CrossviewTruth:
         except (KeyError, TypeError, ValueError) as e:
             raise DatasetError(f"{self._ds.path(twoview_path(i, j))}: {e}") from None
 
+    def fundamental(self, i: str, j: str) -> tuple[np.ndarray | None, str]:
+        """``(F (3, 3) or None, source)``: the truth F of i -> j for UNDISTORTED OpenCV pixels, the
+        stored ``crossview/twoview/<i>/<j>.json`` when the dataset has it, else ``K2^-T [t]x R K1^-1``
+        of cameras.json; None for a zero baseline (one camera centre)."""
+        self._views(i, j)
+        if self._ds.has(twoview_path(i, j)):
+            return self.twoview(i, j).F, str(twoview_path(i, j))
+        (c1, p1), (c2, p2) = self._ds.camera(i), self._ds.camera(j)
+        rel = p2 @ p1.inverse()
+        if np.linalg.norm(rel.t) == 0.0:
+            return None, f"{CAMERAS}: one camera centre"
+        return fundamental(c1.K, c2.K, rel), f"{CAMERAS}: K2^-T [t]x R K1^-1"
+
     def has_matches(self, i: str, j: str, kind: str) -> bool:
         return self._ds.has(matches_path(i, j, kind))
 
@@ -212,6 +229,27 @@ class CrossviewTruth:
         """(H, W, 2) float32 optical flow i -> j (px), NaN where unknown."""
         self._views(i, j)
         return self._ds.read(flow_path(i, j), lambda p: decode_flo(p.read_bytes()), f"flow {i!r} -> {j!r}")
+
+    def pair_flow(self, i: str, j: str) -> tuple[np.ndarray, np.ndarray | None, str] | None:
+        """The optical flow truth the dataset holds for views i -> j, ``(flow (H, W, 2) px,
+        states (H, W) uint8 or None, source file)``, or None when it holds none: a sequence's motion
+        truth of the pair (flow and occlusion states at j's time, moving objects too), else the flow
+        file (consecutive frames), else the correspondence field ``uv - pixel`` of a crossview pair,
+        with the states of the correspondence file when there is one. Non-finite where unknown."""
+        self._views(i, j)
+        if self._ds.has(motion_path(i, j)):
+            m = self._ds.sequence.motion(i, j)
+            return m.flow, m.state, str(motion_path(i, j))
+        corr = self.correspondence(i, j) if self.has_correspondence(i, j) else None
+        if self._ds.has(flow_path(i, j)):
+            flow, source = self.flow(i, j), str(flow_path(i, j))
+        elif corr is not None:
+            H, W = corr.shape
+            grid = np.stack(np.meshgrid(np.arange(W, dtype=np.float64), np.arange(H, dtype=np.float64)), -1)
+            flow, source = corr.uv - grid, str(correspondence_path(i, j)) + " (uv - pixel)"
+        else:
+            return None
+        return flow, None if corr is None else corr.state, source
 
     def view_targets(self, view: str) -> dict:
         """Per-view calibration-target truth: board name -> points' uv, depth, state, facing."""

@@ -49,7 +49,7 @@ from scenegen.dataset.photometric import ViewLight, decode_albedo, decode_lights
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.sequence_reader import SequenceTruth
 from scenegen.dataset.stream_reader import Streams
-from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, decode_truth
+from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, TruthKind, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
 
@@ -194,6 +194,10 @@ class Dataset:
         """The rendered image: (H, W, 3) RGB or (H, W) grey, uint8 or uint16."""
         return self.read(self._view_file(view, "image"), read_png, f"image of view {view!r}")
 
+    def image_path(self, view: str) -> Path:
+        """The rendered image's file (images/<view>.png), for tools that read files."""
+        return self.path(self._view_file(view, "image"))
+
     def linear_image(self, view: str) -> np.ndarray:
         """Clean linear radiance, (H, W, 3) float32 RGB."""
         ch = self.read(self._view_file(view, "linear"), read_exr, f"linear image of view {view!r}")
@@ -219,11 +223,16 @@ class Dataset:
 
     def depth_z(self, view: str) -> np.ndarray:
         """(H, W) float32 z-depth, metres; +inf where the ray hit nothing."""
-        return self._truth_channel(view, "depth_z")
+        return self._truth_channel(view, TruthKind.DEPTH_Z)
 
     def points_world(self, view: str) -> np.ndarray:
         """(H, W, 3) float32 world points, metres; NaN where the ray hit nothing."""
-        return self._truth_channel(view, "points_world")
+        return self._truth_channel(view, TruthKind.POINTS_WORLD)
+
+    def object_ids(self, view: str) -> np.ndarray:
+        """(H, W) uint32 object id of each pixel centre's hit (spec object k is k + 1; 0 = none)."""
+        return self.read(self._view_file(view, "ids"), lambda p: read_exr(p)[TruthKind.OBJECT_ID],
+                         f"object ids of view {view!r}")
 
     def _truth_channel(self, view: str, key: str) -> np.ndarray:
         prefix, comps = TRUTH_FLOAT_CHANNELS[key]

@@ -1,6 +1,7 @@
-"""Per-pixel truth of a view as stored: the keys, their channels, the rules, encode and decode.
+"""Per-pixel truth of a view as stored: the kinds, their channels, the rules, encode and decode.
 
-Keys (:data:`TRUTH_KEYS`), all over the view's pixel centres, (H, W) or (H, W, C):
+Kinds (:class:`TruthKind`, the keys of a truth dict, :data:`TRUTH_KEYS`; each kind's storage in
+:data:`TRUTH_KIND_INFO`), all over the view's pixel centres, (H, W) or (H, W, C):
 
 * ``depth_z`` (H, W) metres along the optical axis; ``range`` (H, W) metres from the optical
   centre (+inf where the ray hit nothing);
@@ -15,6 +16,8 @@ Files: ``truth/<view>.exr`` (float32 channels of :data:`TRUTH_FLOAT_CHANNELS`),
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from enum import Enum
 from typing import Mapping
 
 import numpy as np
@@ -22,19 +25,72 @@ import numpy as np
 from scenegen.dataset.codecs.exr import encode_exr, pack_channels, unpack_channels
 from scenegen.dataset.codecs.png import encode_png
 
-#: Truth key -> (EXR channel prefix, component names); components None = a scalar channel.
-TRUTH_FLOAT_CHANNELS: dict[str, tuple[str, tuple[str, ...] | None]] = {
-    "depth_z": ("depth_z", None),  # (H, W) metres along the optical axis
-    "range": ("range", None),  # (H, W) metres from the optical centre
-    "points_world": ("P_world", ("X", "Y", "Z")),  # (H, W, 3) metres, world frame
-    "points_cam": ("P_cam", ("X", "Y", "Z")),  # (H, W, 3) metres, OpenCV camera frame
-    "normals_world": ("N_world", ("X", "Y", "Z")),  # (H, W, 3) unit, world frame
-    "normals_cam": ("N_cam", ("X", "Y", "Z")),  # (H, W, 3) unit, camera frame
-    "uv": ("uv", ("U", "V")),  # (H, W, 2) texture coordinates
+
+class TruthKind(str, Enum):
+    """The per-pixel truth kinds: the one place their names are written. A member equals its
+    string (``TruthKind.DEPTH_Z == "depth_z"``, same hash, formats as the string), so truth dicts,
+    EXR channels and JSON keep today's names; :attr:`info` holds each kind's storage."""
+
+    DEPTH_Z = "depth_z"
+    RANGE = "range"
+    POINTS_WORLD = "points_world"
+    POINTS_CAM = "points_cam"
+    NORMALS_WORLD = "normals_world"
+    NORMALS_CAM = "normals_cam"
+    UV = "uv"
+    OBJECT_ID = "object_id"
+    INSTANCE_ID = "instance_id"
+    VALID = "valid"
+
+    __str__ = str.__str__  # the string itself, as enum.StrEnum (3.11) does
+    __format__ = str.__format__
+
+    @property
+    def info(self) -> "TruthKindInfo":
+        return TRUTH_KIND_INFO[self]
+
+
+@dataclass(frozen=True)
+class TruthKindInfo:
+    """How a truth kind is stored. ``dtype``: of the stored array; ``components``: the EXR
+    channel suffixes of a vector kind, None for an (H, W) kind; ``exr_prefix``: the EXR channel
+    (prefix) in its file; ``unit``; ``file``: the view file holding it (a key of
+    :func:`scenegen.dataset.layout.view_paths`: ``truth``, ``ids`` or ``valid``); ``miss``: its
+    value where the ray hit nothing."""
+
+    dtype: type
+    components: tuple[str, ...] | None
+    exr_prefix: str | None
+    unit: str
+    file: str
+    miss: float | int | bool
+
+
+_XYZ = ("X", "Y", "Z")
+#: Each kind's storage, in the order of a truth dict (float kinds, ids, valid).
+TRUTH_KIND_INFO: dict[TruthKind, TruthKindInfo] = {
+    TruthKind.DEPTH_Z: TruthKindInfo(np.float32, None, "depth_z", "metres along the optical axis", "truth", np.inf),
+    TruthKind.RANGE: TruthKindInfo(np.float32, None, "range", "metres from the optical centre", "truth", np.inf),
+    TruthKind.POINTS_WORLD: TruthKindInfo(np.float32, _XYZ, "P_world", "metres, world frame", "truth", np.nan),
+    TruthKind.POINTS_CAM: TruthKindInfo(np.float32, _XYZ, "P_cam", "metres, OpenCV camera frame", "truth", np.nan),
+    TruthKind.NORMALS_WORLD: TruthKindInfo(np.float32, _XYZ, "N_world", "unit vector, world frame", "truth", np.nan),
+    TruthKind.NORMALS_CAM: TruthKindInfo(np.float32, _XYZ, "N_cam", "unit vector, camera frame", "truth", np.nan),
+    TruthKind.UV: TruthKindInfo(np.float32, ("U", "V"), "uv", "texture coordinates (v = 0 at the top row)",
+                                "truth", np.nan),
+    TruthKind.OBJECT_ID: TruthKindInfo(np.uint32, None, "object_id", "id (spec object k is k + 1)", "ids", 0),
+    TruthKind.INSTANCE_ID: TruthKindInfo(np.uint32, None, "instance_id", "id", "ids", 0),
+    TruthKind.VALID: TruthKindInfo(np.bool_, None, None, "bool (png 255 = valid)", "valid", False),
 }
-TRUTH_ID_KEYS = ("object_id", "instance_id")  # (H, W) uint32, 0 = no object
+
+#: Truth kind -> (EXR channel prefix, component names); components None = a scalar channel.
+TRUTH_FLOAT_CHANNELS: dict[TruthKind, tuple[str, tuple[str, ...] | None]] = {
+    k: (i.exr_prefix, i.components) for k, i in TRUTH_KIND_INFO.items() if i.file == "truth"}
+#: (H, W) uint32 kinds, 0 = no object; stored as the channels of the same names in truth/<view>_ids.exr.
+TRUTH_ID_KEYS: tuple[TruthKind, ...] = tuple(k for k, i in TRUTH_KIND_INFO.items() if i.file == "ids")
 #: Every key of a truth dict (writer input and reader output).
-TRUTH_KEYS = tuple(TRUTH_FLOAT_CHANNELS) + TRUTH_ID_KEYS + ("valid",)
+TRUTH_KEYS: tuple[TruthKind, ...] = tuple(TRUTH_KIND_INFO)
+#: Kinds that are +inf (not NaN) on misses.
+TRUTH_DISTANCE_KEYS = (TruthKind.DEPTH_Z, TruthKind.RANGE)
 _UINT32_MAX = np.iinfo(np.uint32).max
 VALID_PNG_VALUE = 255  # a valid pixel in truth/<view>_valid.png
 #: The linear image's channels (images/<view>_linear.exr).
@@ -51,50 +107,52 @@ def check_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None =
     if given. Misses (``~valid``) must carry depth_z = range = +inf, NaN points, normals and uv,
     and ids 0; hits finite depth_z, range, points and normals.
     """
-    missing = [k for k in TRUTH_KEYS if k not in truth]
+    missing = [k.value for k in TRUTH_KEYS if k not in truth]
     extra = [k for k in truth if k not in TRUTH_KEYS]
     if missing or extra:
-        raise ValueError(f"truth keys: missing {missing}, unknown {extra}; expected {list(TRUTH_KEYS)}")
-    valid = np.asarray(truth["valid"])
+        raise ValueError(f"truth keys: missing {missing}, unknown {extra}; expected {[k.value for k in TRUTH_KEYS]}")
+    valid = np.asarray(truth[TruthKind.VALID])
     if valid.dtype != np.bool_ or valid.ndim != 2:
         raise TypeError(f"truth 'valid' must be an (H, W) bool array, got {valid.dtype} {valid.shape}")
     hw = valid.shape
     if shape is not None and tuple(shape) != hw:
         raise ValueError(f"truth is {hw} (H, W) but the image is {tuple(shape)}")
-    out: dict[str, np.ndarray] = {"valid": valid}
+    out: dict[str, np.ndarray] = {TruthKind.VALID: valid}
     miss = ~valid
     n_valid = int(np.count_nonzero(valid))
     n_miss = valid.size - n_valid
     # whole-array tests and counts: no copies through the masks (this runs on every frame)
     for key, (_, comps) in TRUTH_FLOAT_CHANNELS.items():
         a = np.asarray(truth[key])
+        name = key.value
         want = hw if comps is None else hw + (len(comps),)
         if not np.issubdtype(a.dtype, np.floating):
-            raise TypeError(f"truth {key!r} must be a float array (stored as float32), got {a.dtype}")
+            raise TypeError(f"truth {name!r} must be a float array (stored as float32), got {a.dtype}")
         if a.shape != want:
-            raise ValueError(f"truth {key!r} must have shape {want}, got {a.shape}")
+            raise ValueError(f"truth {name!r} must have shape {want}, got {a.shape}")
         a = a.astype(np.float32, copy=False)
         n_comp = 1 if comps is None else len(comps)
-        if key in ("depth_z", "range"):
+        if key in TRUTH_DISTANCE_KEYS:
             if np.count_nonzero((a == np.inf) & miss) != n_miss:
-                raise ValueError(f"truth {key!r} must be +inf where valid is False")
+                raise ValueError(f"truth {name!r} must be +inf where valid is False")
         else:
             planes = [a] if comps is None else [a[..., i] for i in range(n_comp)]  # contiguous when planar
             if any(np.count_nonzero(np.isnan(p) & miss) != n_miss for p in planes):
-                raise ValueError(f"truth {key!r} must be NaN where valid is False")
+                raise ValueError(f"truth {name!r} must be NaN where valid is False")
         # misses are +inf or NaN, never finite: all hits are finite iff the finite count is theirs
-        if key != "uv" and np.count_nonzero(np.isfinite(a)) != n_valid * n_comp:
-            raise ValueError(f"truth {key!r} must be finite where valid is True")
+        if key != TruthKind.UV and np.count_nonzero(np.isfinite(a)) != n_valid * n_comp:
+            raise ValueError(f"truth {name!r} must be finite where valid is True")
         out[key] = a
     for key in TRUTH_ID_KEYS:
         a = np.asarray(truth[key])
+        name = key.value
         if not np.issubdtype(a.dtype, np.integer) or a.shape != hw:
-            raise TypeError(f"truth {key!r} must be an integer (H, W) = {hw} array, got {a.dtype} {a.shape}")
+            raise TypeError(f"truth {name!r} must be an integer (H, W) = {hw} array, got {a.dtype} {a.shape}")
         if a.dtype != np.uint32 and a.size and (a.min() < 0 or a.max() > _UINT32_MAX):
-            raise ValueError(f"truth {key!r} values must lie in [0, 2^32 - 1]")
+            raise ValueError(f"truth {name!r} values must lie in [0, 2^32 - 1]")
         a = a.astype(np.uint32, copy=False)
         if np.count_nonzero((a != 0) & miss):
-            raise ValueError(f"truth {key!r} must be 0 where valid is False")
+            raise ValueError(f"truth {name!r} must be 0 where valid is False")
         out[key] = a
     return out
 
@@ -110,14 +168,19 @@ def truth_float_channels(truth: Mapping[str, np.ndarray]) -> dict[str, np.ndarra
     return ch
 
 
+def truth_id_channels(truth: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The uint32 EXR channels (truth/<view>_ids.exr) of a checked truth dict, named by kind."""
+    return {k.value: truth[k] for k in TRUTH_ID_KEYS}
+
+
 def encode_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None) -> dict[str, bytes]:
     """The three truth files of a view, by key ``truth``, ``ids``, ``valid`` (see the module
     docstring); ``truth`` is checked with :func:`check_truth` first."""
     t = check_truth(truth, shape=shape)
     return {
         "truth": encode_exr(truth_float_channels(t)),
-        "ids": encode_exr({k: t[k] for k in TRUTH_ID_KEYS}),
-        "valid": encode_png(np.where(t["valid"], np.uint8(VALID_PNG_VALUE), np.uint8(0))),
+        "ids": encode_exr(truth_id_channels(t)),
+        "valid": encode_png(np.where(t[TruthKind.VALID], np.uint8(VALID_PNG_VALUE), np.uint8(0))),
     }
 
 
@@ -128,6 +191,6 @@ def decode_truth(float_channels: Mapping[str, np.ndarray], id_channels: Mapping[
     for key, (prefix, comps) in TRUTH_FLOAT_CHANNELS.items():
         out[key] = float_channels[prefix] if comps is None else unpack_channels(float_channels, prefix, comps)
     for key in TRUTH_ID_KEYS:
-        out[key] = id_channels[key]
-    out["valid"] = np.asarray(valid_png) == VALID_PNG_VALUE
+        out[key] = id_channels[key.value]
+    out[TruthKind.VALID] = np.asarray(valid_png) == VALID_PNG_VALUE
     return out

@@ -23,6 +23,7 @@ import numpy as np
 
 from scenegen.dataset import DatasetError
 from scenegen.dataset.crossview import VISIBLE
+from scenegen.dataset.truth import TruthKind
 from scenegen.export.common import each, fmt, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
@@ -68,14 +69,14 @@ def tracks(ds, cams: dict, poses: dict, vid: dict, progress=None) -> tuple[dict[
     for i, others in each(links.items(), progress):
         truth = ds.truth(i)
         image = to_uint8(ds.image(i))
-        H, W = truth["valid"].shape
+        H, W = truth[TruthKind.VALID].shape
         gv, gu = np.meshgrid(np.arange(0, H, STRIDE_PX), np.arange(0, W, STRIDE_PX), indexing="ij")
         gv, gu = gv.ravel(), gu.ravel()
         vis = {j: ds.crossview.correspondence(i, j).state[gv, gu] == VISIBLE for j in others}
         seen_elsewhere = np.any(np.stack(list(vis.values())), axis=0) if vis else np.ones(gv.shape, bool)
-        any_vis = seen_elsewhere & truth["valid"][gv, gu]
+        any_vis = seen_elsewhere & truth[TruthKind.VALID][gv, gu]
         for k in np.flatnonzero(any_vis):
-            X = truth["points_world"][gv[k], gu[k]].astype(np.float64)
+            X = truth[TruthKind.POINTS_WORLD][gv[k], gu[k]].astype(np.float64)
             seen = []
             for view in [i] + [j for j in others if vis[j][k]]:
                 uv = cams[view].project(poses[view].apply(X[None]))[0]

@@ -31,6 +31,7 @@ import numpy as np
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.files import copy_file
 from scenegen.dataset.layout import view_paths
+from scenegen.dataset.truth import TruthKind
 from scenegen.export.common import depth_png16, each, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.camera import camera_model
@@ -76,10 +77,10 @@ def export(ds, dest, progress=None) -> dict:
         intr = intrinsics(cam)
         all_intr.append(json.dumps(intr, sort_keys=True))
         truth = ds.truth(v)
-        depth, n = depth_png16(truth["depth_z"], truth["valid"], DEPTH_UNITS_PER_M)
+        depth, n = depth_png16(truth[TruthKind.DEPTH_Z], truth[TruthKind.VALID], DEPTH_UNITS_PER_M)
         too_far += n
         write(dest, f"depth/{v}.png", encode_png(depth))
-        write(dest, f"masks/{v}.png", encode_png(np.where(truth["valid"], 255, 0).astype(np.uint8)))
+        write(dest, f"masks/{v}.png", encode_png(np.where(truth[TruthKind.VALID], 255, 0).astype(np.uint8)))
         frames.append({"file_path": f"images/{v}.png", "depth_file_path": f"depth/{v}.png",
                        "depth_path": f"depth/{v}.png",
                        "mask_path": f"masks/{v}.png", **intr,

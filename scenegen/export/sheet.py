@@ -18,6 +18,7 @@ import html
 import cv2
 import numpy as np
 
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import to_uint8
 
 KINDS = ("image", "depth", "normals", "ids")
@@ -99,12 +100,12 @@ def resized(tile: np.ndarray, width: int, nearest: bool = False) -> np.ndarray:
 
 def view_tiles(image, truth: dict, width: int) -> tuple[list[np.ndarray], str]:
     """The four tiles of a view (KINDS order) at ``width`` pixels, and the row's caption extra."""
-    valid = np.asarray(truth["valid"], bool)
-    depth, rng = depth_tile(truth["depth_z"], valid)
+    valid = np.asarray(truth[TruthKind.VALID], bool)
+    depth, rng = depth_tile(truth[TruthKind.DEPTH_Z], valid)
     tiles = [resized(image_tile(image), width), resized(depth, width),
-             resized(normals_tile(truth["normals_cam"], valid), width),
-             resized(id_colours(truth["instance_id"]), width, nearest=True)]
-    ids = np.unique(np.asarray(truth["instance_id"])[valid])
+             resized(normals_tile(truth[TruthKind.NORMALS_CAM], valid), width),
+             resized(id_colours(truth[TruthKind.INSTANCE_ID]), width, nearest=True)]
+    ids = np.unique(np.asarray(truth[TruthKind.INSTANCE_ID])[valid])
     extra = (f"depth {rng[0]:.3g}-{rng[1]:.3g} m, " if rng else "no surface, ") + f"{len(ids)} instances"
     return tiles, extra
 

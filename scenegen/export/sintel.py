@@ -33,6 +33,7 @@ import numpy as np
 from scenegen.dataset.codecs import encode_cam, encode_dpt, encode_png
 from scenegen.dataset.crossview import NO_SURFACE, VISIBLE
 from scenegen.dataset.layout import sequence_flow_path
+from scenegen.dataset.truth import TruthKind
 from scenegen.export.common import name, write
 from scenegen.export.errors import ExportError
 from scenegen.geometry.color import to_uint8
@@ -87,7 +88,8 @@ def export(ds, dest, progress=None) -> dict:
             cam, pose = ds.camera(v)
             truth = ds.truth(v)
             write(dest, f"training/final/{frame}.png", encode_png(_rgb8(ds.image(v))))
-            write(dest, f"training/depth/{frame}.dpt", encode_dpt(np.where(truth["valid"], truth["depth_z"], 0.0)))
+            depth = np.where(truth[TruthKind.VALID], truth[TruthKind.DEPTH_Z], 0.0)
+            write(dest, f"training/depth/{frame}.dpt", encode_dpt(depth))
             write(dest, f"training/camdata_left/{frame}.cam",
                   encode_cam(cam.K, np.concatenate([pose.R, pose.t[:, None]], axis=1)))
             n += 3

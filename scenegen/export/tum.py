@@ -19,6 +19,7 @@ A stream is the views of one camera name, rig and rig member, in frame order; it
 from __future__ import annotations
 
 from scenegen.dataset.codecs import encode_png
+from scenegen.dataset.truth import TruthKind
 from scenegen.export.common import depth_png16, fmt, name, write
 from scenegen.export.tum_calib import calibration_files
 from scenegen.geometry.color import to_uint8
@@ -51,7 +52,7 @@ def export(ds, dest, progress=None) -> dict:
             ts = f"{frame:.6f}"
             lines.append(" ".join([ts] + [fmt(c) for c in (*wfc.t, x, y, z, w)]))
             truth = ds.truth(v)
-            d16, far = depth_png16(truth["depth_z"], truth["valid"], DEPTH_UNITS_PER_M)
+            d16, far = depth_png16(truth[TruthKind.DEPTH_Z], truth[TruthKind.VALID], DEPTH_UNITS_PER_M)
             too_far += far
             rgb.append((ts, write(dest, f"{key}/rgb/{ts}.png", encode_png(to_uint8(ds.image(v))))[len(key) + 1:]))
             depth.append((ts, write(dest, f"{key}/depth/{ts}.png", encode_png(d16))[len(key) + 1:]))

@@ -43,6 +43,7 @@ from scenegen.dataset.layout import (
     view_paths,
     view_targets_path,
 )
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
@@ -84,8 +85,8 @@ class CrossviewContext:
         """(H, W, 3) float64 world truth points of a view (NaN = no surface)."""
         if name not in self._points:
             t = view_truth(self.built, self.views[name], as_stored=True)  # the call (and kernel) of the stored truth
-            self._points[name] = np.where(t["valid"][..., None], t["points_world"], np.nan)
-            self._ids[name] = t["object_id"].copy()
+            self._points[name] = np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan)
+            self._ids[name] = t[TruthKind.OBJECT_ID].copy()
         return self._points[name]
 
     def geometry(self, name) -> FrameGeometry:

@@ -39,6 +39,7 @@ from scenegen.dataset.sequence import (
     encode_stereo_motion_channels,
     objects_document,
 )
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.pipeline.pairs import streams
 from scenegen.pipeline.stereo_sequence import StereoSequence, stereo_pairs
@@ -64,15 +65,15 @@ class SequenceTruth:
             if rolling_shutter_rows(self.built, view) is None:
                 wfc = view.cam_from_world.inverse()
                 rays, R = self.built.camera_rays(cam), wfc.R
-                rng = np.where(t["valid"], t["range"], np.nan).reshape(-1)
+                rng = np.where(t[TruthKind.VALID], t[TruthKind.RANGE], np.nan).reshape(-1)
                 # per component, without a BLAS call (no thread pool next to Dr.Jit's)
                 P = np.empty((len(rng), 3))
                 for i in range(3):
                     P[:, i] = wfc.t[i] + rng * (R[i, 0] * rays[:, 0] + R[i, 1] * rays[:, 1] + R[i, 2] * rays[:, 2])
                 P = P.reshape(cam.height, cam.width, 3)
             else:  # per-row poses: the kernel's float32 points
-                P = np.where(t["valid"][..., None], t["points_world"], np.nan).astype(np.float64)
-            self._frames[view.name] = (P, t["object_id"].copy())
+                P = np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan).astype(np.float64)
+            self._frames[view.name] = (P, t[TruthKind.OBJECT_ID].copy())
             while len(self._frames) > self.keep_frames:
                 self._frames.popitem(last=False)
         self._frames.move_to_end(view.name)

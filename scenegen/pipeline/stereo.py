@@ -19,7 +19,7 @@ from scenegen.dataset.codecs import (
 )
 from scenegen.dataset.crossview import VISIBLE, encode_correspondence_channels, encode_rectification_map
 from scenegen.dataset.layout import STEREO_SIDES, stereo_dir, stereo_path
-from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_ID_KEYS
+from scenegen.dataset.truth import LINEAR_CHANNELS, TruthKind, truth_id_channels
 from scenegen.geometry.color import srgb_image
 from scenegen.geometry.rectify import disparity_from_depth, rectification_map, rectify
 from scenegen.geometry.seeds import hashed_seed32
@@ -43,8 +43,9 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
         ctx.write(stereo_path(left, "image", side), encode_png(srgb_image(lin, ctx.spec.render.bit_depth)))
         ctx.write(stereo_path(left, "linear", side), encode_exr(pack_channels("", lin, LINEAR_CHANNELS)))
         t = built.truth(rc, pose)
-        ctx.write(stereo_path(left, "ids", side), encode_exr({k: t[k] for k in TRUTH_ID_KEYS}))
-        truths[side] = (np.where(t["valid"][..., None], t["points_world"], np.nan), t["depth_z"])
+        ctx.write(stereo_path(left, "ids", side), encode_exr(truth_id_channels(t)))
+        truths[side] = (np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan),
+                        t[TruthKind.DEPTH_Z])
     for side, other_pose in zip(STEREO_SIDES, (rect.cam_right_from_world, rect.cam_left_from_world)):
         pts, depth = truths[side]
         d = disparity_from_depth(depth, rect.f, rect.baseline_m)

@@ -18,6 +18,7 @@ import numpy as np
 
 from scenegen.crossview.motion import moved_stereo_correspondence
 from scenegen.dataset.sequence import StereoMotionTruth
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.rectify import Rectification, rectify
 from scenegen.pipeline.pairs import streams
 from scenegen.pipeline.view import correspond_fn
@@ -66,8 +67,8 @@ class StereoSequence:
             rect = self.rectification(frame)
             self.built.set_time(getattr(left, "time_s", None))
             t = self.built.truth(rect.camera, rect.cam_left_from_world)
-            P = np.where(t["valid"][..., None], t["points_world"], np.nan)
-            self._frames[left.name] = (rect, P, t["object_id"].copy())
+            P = np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan)
+            self._frames[left.name] = (rect, P, t[TruthKind.OBJECT_ID].copy())
             while len(self._frames) > self.keep_frames:
                 self._frames.popitem(last=False)
         self._frames.move_to_end(left.name)

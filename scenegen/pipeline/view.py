@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from scenegen.crossview.correspondence import correspond
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.color import srgb_image
 from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict
 from scenegen.geometry.rolling import RollingRows, RowClock, RowPoses, frame_node_rows
@@ -148,8 +149,9 @@ def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
     files = {}
     lens = getattr(built.optics.get(view.camera), "lens", None)
     if spec.truth.defocus and lens is not None:  # the thin lens's blur of each pixel's truth point
-        coc = lens.blur_radius_px(built.cameras[view.camera], truth["depth_z"].astype(np.float64))
-        files[coc_path(view.name)] = encode_exr({COC_CHANNEL: np.where(truth["valid"], coc, np.nan).astype(np.float32)})
+        coc = lens.blur_radius_px(built.cameras[view.camera], truth[TruthKind.DEPTH_Z].astype(np.float64))
+        coc = np.where(truth[TruthKind.VALID], coc, np.nan).astype(np.float32)
+        files[coc_path(view.name)] = encode_exr({COC_CHANNEL: coc})
     if spec.truth.albedo:
         if rolling_shutter_rows(built, view) is not None or (view.motion is not None and not view.motion.is_static) \
                 or built.moving:

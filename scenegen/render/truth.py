@@ -30,6 +30,7 @@ import mitsuba as mi
 import numpy as np
 
 from scenegen.assets.cache import cached_arrays
+from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.pose import Rigid3
@@ -113,7 +114,7 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
         out = _truth_pass_scalar(scene, camera, cam_from_world, id_tables)
         mark_no_ray(out, camera.no_ray_mask())
         if as_stored:
-            out.update({k: out[k].astype(np.float32) for k in ("range", "depth_z")})
+            out.update({k: out[k].astype(np.float32) for k in (TruthKind.RANGE, TruthKind.DEPTH_Z)})
         return out
     H, W = camera.height, camera.width
     if row_poses is None:
@@ -161,9 +162,11 @@ def truth_pass(scene, camera: Camera, cam_from_world: Rigid3, id_tables,
         t, depth_z = mi.Float(t), mi.Float(depth_z)
     # vectors are rounded once to float32 (the stored precision) inside the kernel; range and
     # depth_z stay float64 unless as_stored, so float64 points are C + range * ray when needed
-    vectors = {"points_cam": mi.Vector3f(points_cam), "points_world": mi.Vector3f(points_world),
-               "normals_world": mi.Vector3f(n_world), "normals_cam": mi.Vector3f(n_cam), "uv": uv}
-    scalars = {"range": t, "depth_z": depth_z, "object_id": obj, "instance_id": inst, "valid": hit}
+    vectors = {TruthKind.POINTS_CAM: mi.Vector3f(points_cam), TruthKind.POINTS_WORLD: mi.Vector3f(points_world),
+               TruthKind.NORMALS_WORLD: mi.Vector3f(n_world), TruthKind.NORMALS_CAM: mi.Vector3f(n_cam),
+               TruthKind.UV: uv}
+    scalars = {TruthKind.RANGE: t, TruthKind.DEPTH_Z: depth_z, TruthKind.OBJECT_ID: obj,
+               TruthKind.INSTANCE_ID: inst, TruthKind.VALID: hit}
     planar = {k: _planar(v, H * W) for k, v in vectors.items()}
     dr.eval(*planar.values(), *scalars.values())  # one kernel for everything; convert only afterwards
     # .numpy() of an evaluated flat array is a zero-copy view: (C, H, W) seen as (H, W, C)
@@ -183,11 +186,11 @@ def mark_no_ray(out: dict, no_ray: np.ndarray) -> None:
     for k, v in list(out.items()):
         if not v.flags.writeable:
             out[k] = v = v.copy()
-        if k in ("object_id", "instance_id"):
+        if k in (TruthKind.OBJECT_ID, TruthKind.INSTANCE_ID):
             v[no_ray] = 0
-        elif k == "valid":
+        elif k == TruthKind.VALID:
             v[no_ray] = False
-        elif k in ("range", "depth_z"):
+        elif k in (TruthKind.RANGE, TruthKind.DEPTH_Z):
             v[no_ray] = np.inf
         else:
             v[no_ray] = np.nan
@@ -213,17 +216,17 @@ def _truth_pass_scalar(scene, camera: Camera, cam_from_world: Rigid3, id_tables)
     d_cam = camera_rays(camera)
     d_world = d_cam @ world_from_cam.R.T
     hits = _cast_rays_scalar(scene, world_from_cam.t[None], d_world, id_tables)
-    t, valid = hits["t"], hits["valid"]
+    t, valid = hits["t"], hits[TruthKind.VALID]
     t_pts = np.where(valid, t, np.nan)[:, None]
-    n_world = hits["normals_world"].astype(np.float64)
+    n_world = hits[TruthKind.NORMALS_WORLD].astype(np.float64)
     n_world /= np.linalg.norm(n_world, axis=1, keepdims=True)
     out = {
-        "range": t, "depth_z": t * d_cam[:, 2],
-        "points_cam": (d_cam * t_pts).astype(np.float32),
-        "points_world": (world_from_cam.t + d_world * t_pts).astype(np.float32),
-        "normals_world": n_world.astype(np.float32),
-        "normals_cam": (n_world @ world_from_cam.R).astype(np.float32),
-        "uv": hits["uv"], "object_id": hits["object_id"], "instance_id": hits["instance_id"], "valid": valid,
+        TruthKind.RANGE: t, TruthKind.DEPTH_Z: t * d_cam[:, 2],
+        TruthKind.POINTS_CAM: (d_cam * t_pts).astype(np.float32),
+        TruthKind.POINTS_WORLD: (world_from_cam.t + d_world * t_pts).astype(np.float32),
+        TruthKind.NORMALS_WORLD: n_world.astype(np.float32),
+        TruthKind.NORMALS_CAM: (n_world @ world_from_cam.R).astype(np.float32),
+        **{k: hits[k] for k in (TruthKind.UV, TruthKind.OBJECT_ID, TruthKind.INSTANCE_ID)}, TruthKind.VALID: valid,
     }
     return {k: v.reshape((H, W) + v.shape[1:]) for k, v in out.items()}
 
@@ -231,9 +234,9 @@ def _truth_pass_scalar(scene, camera: Camera, cam_from_world: Rigid3, id_tables)
 def _cast_rays_scalar(scene, origins_world, dirs_world, id_tables) -> dict[str, np.ndarray]:
     obj_by_id, inst_by_id = id_tables
     n_rays = len(dirs_world)
-    out = {"t": np.full(n_rays, np.inf), "normals_world": np.full((n_rays, 3), np.nan, np.float32),
-           "uv": np.full((n_rays, 2), np.nan, np.float32), "object_id": np.zeros(n_rays, np.uint32),
-           "instance_id": np.zeros(n_rays, np.uint32), "valid": np.zeros(n_rays, bool)}
+    out = {"t": np.full(n_rays, np.inf), TruthKind.NORMALS_WORLD: np.full((n_rays, 3), np.nan, np.float32),
+           TruthKind.UV: np.full((n_rays, 2), np.nan, np.float32), TruthKind.OBJECT_ID: np.zeros(n_rays, np.uint32),
+           TruthKind.INSTANCE_ID: np.zeros(n_rays, np.uint32), TruthKind.VALID: np.zeros(n_rays, bool)}
     o = origins_world.astype(np.float32)
     for i, d in enumerate(dirs_world.astype(np.float32)):
         oi = o[0] if len(o) == 1 else o[i]
@@ -242,9 +245,9 @@ def _cast_rays_scalar(scene, origins_world, dirs_world, id_tables) -> dict[str, 
             continue
         sid = si.shape.id()
         out["t"][i] = si.t
-        out["normals_world"][i] = list(si.sh_frame.n)
-        out["uv"][i] = list(si.uv)
-        out["object_id"][i] = obj_by_id.get(sid, 0)
-        out["instance_id"][i] = inst_by_id.get(sid, 0)
-        out["valid"][i] = True
+        out[TruthKind.NORMALS_WORLD][i] = list(si.sh_frame.n)
+        out[TruthKind.UV][i] = list(si.uv)
+        out[TruthKind.OBJECT_ID][i] = obj_by_id.get(sid, 0)
+        out[TruthKind.INSTANCE_ID][i] = inst_by_id.get(sid, 0)
+        out[TruthKind.VALID][i] = True
     return out

@@ -1,5 +1,6 @@
 """The evaluator's view of a scenegen dataset (recon_eval.readers.scenegen_dataset) on the analytic
 plane dataset of conftest.py: poses, cameras, depth, disparity, held-out points, meshes, errors."""
+import shutil
 import subprocess
 import sys
 
@@ -8,6 +9,7 @@ import pytest
 
 from recon_eval.errors import InputError
 from recon_eval.readers.scenegen_dataset import is_dataset, read_dataset
+from scenegen.dataset import Dataset, TruthKind
 
 
 class TestScenegenDataset:
@@ -56,6 +58,24 @@ class TestScenegenDataset:
             d.depth("nope")
         with pytest.raises(InputError, match="not a scenegen dataset"):
             read_dataset(tmp_path)
+
+    def test_dataset_accessors_with_the_evaluators_errors(self, plane_dataset, tmp_path):
+        """Every Dataset accessor is reached through DatasetTruth, with its errors as InputError."""
+        d, ds = read_dataset(plane_dataset[0]), Dataset(plane_dataset[0])
+        v = d.views[0]
+        assert d.dataset.root == ds.root and d.scene_name == ds.scene_name and d.objects == ds.objects
+        assert np.array_equal(d.image(v), ds.image(v)) and d.image_path(v) == ds.image_path(v)
+        assert np.array_equal(d.object_ids(v), ds.truth(v)[TruthKind.OBJECT_ID])
+        assert d.views_of_camera(d.view_info(v)["camera_name"]) == ds.views_of_camera(ds.view_info(v)["camera_name"])
+        with pytest.raises(InputError, match="'nope' is not a complete view"):
+            d.image("nope")
+        with pytest.raises(AttributeError):
+            d.no_such_accessor
+        damaged = tmp_path / "damaged"
+        shutil.copytree(plane_dataset[0], damaged)
+        (damaged / "truth" / f"{v}_ids.exr").write_bytes(b"not an EXR")
+        with pytest.raises(InputError, match=rf"truth/{v}_ids\.exr: unreadable object ids"):
+            read_dataset(damaged).object_ids(v)
 
 
 def test_readers_import_no_mitsuba(plane_dataset):

@@ -116,6 +116,9 @@ class TestLayoutAndReader:
             assert set(t) == set(ds.TRUTH_KEYS)
             for k in ds.TRUTH_KEYS:
                 assert bits_equal(t[k], src["truth"][k]), (v, k)
+            assert bits_equal(d.object_ids(v), src["truth"]["object_id"])  # the ids file alone
+            assert bits_equal(d.depth_z(v), src["truth"]["depth_z"])
+            assert d.image_path(v) == complete / f"images/{v}.png"
 
     def test_camera_and_info(self, complete):
         d = ds.Dataset(complete)

@@ -5,6 +5,7 @@ import pytest
 from scenegen.dataset import Dataset, DatasetError
 from scenegen.dataset import codecs as sio
 from scenegen.dataset.crossview import MATCH_COLUMNS, VISIBLE, decode_correspondence_channels
+from scenegen.geometry.twoview import undistorted_pixels
 
 pytestmark = pytest.mark.render
 
@@ -81,3 +82,36 @@ def test_stereo_frames_without_pairs():
 
     cv = CrossviewTruth(Fake())
     assert len(cv) == 0 and [(f.left_view, f.right_view) for f in cv.stereo_frames()] == [("l0", "r0")]
+
+
+def test_fundamental_stored_or_from_cameras(ds):
+    """The stored F where the dataset has one; else K2^-T [t]x R K1^-1 of cameras.json, checked here
+    against the dataset's own visible correspondences (read in the pair's other direction)."""
+    i, j = "st_left_0000", "side_0002"
+    F, source = ds.crossview.fundamental(i, j)
+    assert source == f"crossview/twoview/{i}/{j}.json" and np.array_equal(F, ds.crossview.twoview(i, j).F)
+    assert not ds.has(f"crossview/twoview/{j}/{i}.json")
+    F_ji, source = ds.crossview.fundamental(j, i)
+    assert source == "cameras.json: K2^-T [t]x R K1^-1"
+    c = ds.crossview.correspondence(i, j)
+    vv, uu = np.nonzero(c.visible)
+    und_i = undistorted_pixels(ds.camera(i)[0], np.stack([uu, vv], 1))  # F is for undistorted pixels
+    und_j = undistorted_pixels(ds.camera(j)[0], c.uv[vv, uu])
+    x_i, x_j = (np.concatenate([x, np.ones((len(x), 1))], 1) for x in (und_i, und_j))
+    lines = x_j @ F_ji.T  # epipolar lines in view i of view j's points
+    dist_px = np.abs(np.sum(lines * x_i, 1)) / np.hypot(lines[:, 0], lines[:, 1])
+    assert len(dist_px) > 100 and dist_px.max() < 1e-2
+
+
+def test_pair_flow_is_the_held_flow_truth(ds):
+    i, j = "st_left_0000", "side_0002"  # a crossview pair: correspondences, no flow file
+    flow, states, source = ds.crossview.pair_flow(i, j)
+    c = ds.crossview.correspondence(i, j)
+    H, W = c.shape
+    np.testing.assert_array_equal(flow[..., 0], c.uv[..., 0] - np.arange(W)[None, :])
+    np.testing.assert_array_equal(flow[..., 1], c.uv[..., 1] - np.arange(H)[:, None])
+    assert np.array_equal(states, c.state) and source == f"crossview/corr/{i}/{j}.exr (uv - pixel)"
+    for a, b in ds.crossview.index.flow:
+        flow, _, source = ds.crossview.pair_flow(a, b)
+        assert source == f"crossview/flow/{a}/{b}.flo" and np.array_equal(flow, ds.crossview.flow(a, b), equal_nan=True)
+    assert ds.crossview.pair_flow("st_right_0000", "side_0002") is None
