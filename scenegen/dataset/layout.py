@@ -17,6 +17,7 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_albedo.exr                 diffuse albedo per pixel centre (albedo.R/G/B; spec truth.albedo)
     truth/<view>_lights.json                the lights on in the view, camera frame (spec truth.lights)
     truth/<view>_coc.exr                    thin-lens circle of confusion per pixel (channel coc_radius_px; truth.defocus)
+    truth/<view>_boxes.json                 2D and 3D bounding boxes per object (truth.boxes)
     raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
     images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote
@@ -53,7 +54,8 @@ NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 MAX_NAME_LEN = 128
 #: A view name may not end like another view's suffixed files (view "a_ids" would clash with
 #: view "a"'s truth/a_ids.exr).
-RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw", "_albedo", "_lights", "_coc")
+RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw", "_albedo", "_lights", "_coc",
+                          "_boxes")
 MATCH_KINDS = ("synthetic", "sift")
 
 CROSSVIEW = "crossview"
@@ -166,6 +168,14 @@ def coc_path(view: str) -> str:
 def lights_path(view: str) -> str:
     """The calibrated lights of a view, in its camera frame (an extra file of the view)."""
     return LIGHTS_TEMPLATE.format(view=check_view_name(view))
+
+
+BOXES_TEMPLATE = "truth/{view}_boxes.json"
+
+
+def boxes_path(view: str) -> str:
+    """The 2D and 3D bounding boxes of every object in a view (an extra file of the view)."""
+    return BOXES_TEMPLATE.format(view=check_view_name(view))
 
 
 #: The raw mosaic of a view of a camera with ``imaging.raw`` (templates recorded in cameras.json).

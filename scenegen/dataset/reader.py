@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from scenegen.dataset.boxes import ViewBoxes, decode_boxes
 from scenegen.dataset.cameras import camera_of
 from scenegen.dataset.codecs.dng import read_dng
 from scenegen.dataset.codecs.exr import read_exr, unpack_channels
@@ -33,6 +34,7 @@ from scenegen.dataset.layout import (
     VIGNETTING_CHANNEL,
     COC_CHANNEL,
     albedo_path,
+    boxes_path,
     check_listed_names,
     coc_path,
     check_rel_path,
@@ -265,6 +267,14 @@ class Dataset:
         or None when the spec did not ask for them (``truth: {lights: true}``)."""
         rel = lights_path(self.check_view(view))
         return self.read(rel, lambda p: decode_lights(read_json(p), str(p)), f"lights of view {view!r}") \
+            if self.has(rel) else None
+
+    def boxes(self, view: str) -> ViewBoxes | None:
+        """Every object's visible and amodal 2D boxes and 3D box in a view
+        (:class:`scenegen.dataset.boxes.ViewBoxes`), or None when the spec did not ask for them
+        (``truth: {boxes: true}``)."""
+        rel = boxes_path(self.check_view(view))
+        return self.read(rel, lambda p: decode_boxes(read_json(p), str(p)), f"boxes of view {view!r}") \
             if self.has(rel) else None
 
     def raw(self, view: str, kind: str | None = None) -> RawImage | None:

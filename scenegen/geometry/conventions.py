@@ -16,6 +16,13 @@ Internal conventions (used everywhere in scenegen and recon_eval):
 Foreign conventions, one function (or constant) each:
 
 * COLMAP pixels: the top-left pixel's centre is (0.5, 0.5): ``colmap = opencv + 0.5``.
+* COCO boxes ``[x, y, w, h]`` are in pixel-edge coordinates (the top-left pixel covers [0, 1]^2):
+  the box of the pixels whose centres span ``[u_min, u_max] x [v_min, v_max]`` is
+  ``[u_min, v_min, u_max - u_min + 1, v_max - v_min + 1]`` (``coco_box_of_pixels``); an extent of
+  OpenCV positions is ``[u_min + 0.5, v_min + 0.5, u_max - u_min, v_max - v_min]``
+  (``coco_box_of_extent``).
+* 3D box corners: corner k of a box with centre c and size s is ``c + BOX_CORNER_SIGNS[k] * s / 2``,
+  the signs (-1, +1) in itertools.product order (x slowest, z fastest).
 * Mitsuba film: sample position s in [0, 1]^2 over the image, pixel i covers [i, i + 1] in film
   pixel units, so ``u = s_x * W - 0.5``. Mitsuba camera axes: +x LEFT, +y UP, +z forward (a 180
   degree rotation about z from OpenCV). Its ``to_world`` is camera-to-world.
@@ -175,6 +182,32 @@ def pixel_centers(width: int, height: int) -> np.ndarray:
     """(H, W, 2) float64 OpenCV coordinates of every pixel centre: [v, u] -> (u, v) = (u, v)."""
     u, v = np.meshgrid(np.arange(width, dtype=np.float64), np.arange(height, dtype=np.float64))
     return np.stack([u, v], axis=-1)
+
+
+# --- boxes -------------------------------------------------------------------------------------
+#: (8, 3) signs of a 3D box's corners: corner k = centre + BOX_CORNER_SIGNS[k] * size / 2
+#: (x slowest, z fastest: (-,-,-), (-,-,+), (-,+,-), ..., (+,+,+)).
+BOX_CORNER_SIGNS = np.array([[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)])
+
+
+def box_corners(center, size) -> np.ndarray:
+    """(8, 3) corners of the axis-aligned box with ``center`` (3,) and ``size`` (3,), in the order
+    of :data:`BOX_CORNER_SIGNS`."""
+    return np.asarray(center, np.float64) + BOX_CORNER_SIGNS * (np.asarray(size, np.float64) / 2.0)
+
+
+def coco_box_of_pixels(box_xyxy) -> list[float]:
+    """COCO ``[x, y, w, h]`` (pixel edges) of the pixels whose OpenCV centres span ``box_xyxy`` =
+    ``[u_min, v_min, u_max, v_max]`` (inclusive; a single pixel u is [u, u + 1] in COCO)."""
+    u0, v0, u1, v1 = (float(x) for x in box_xyxy)
+    return [u0, v0, u1 - u0 + 1.0, v1 - v0 + 1.0]
+
+
+def coco_box_of_extent(box_xyxy) -> list[float]:
+    """COCO ``[x, y, w, h]`` (pixel edges) of an extent ``[u_min, v_min, u_max, v_max]`` of OpenCV
+    positions (``coco = opencv + 0.5``, like COLMAP's)."""
+    u0, v0, u1, v1 = (float(x) for x in box_xyxy)
+    return [u0 + 0.5, v0 + 0.5, u1 - u0, v1 - v0]
 
 
 # --- depth vs range ---------------------------------------------------------------------------

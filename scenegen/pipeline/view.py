@@ -19,6 +19,7 @@ from scenegen.dataset.codecs.exr import encode_exr
 from scenegen.dataset.layout import COC_CHANNEL, albedo_path, coc_path, lights_path
 from scenegen.dataset.photometric import encode_albedo
 from scenegen.imaging.stage import apply_imaging
+from scenegen.pipeline.view_boxes import view_boxes_file
 from scenegen.spec.light_truth import view_lights_document
 from scenegen.spec.timeline import poses_within_frame
 
@@ -137,14 +138,15 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
         # mosaic with imaging.raw
         image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name,
                                      camera_name=v.camera)
-    if spec.truth is not None and (spec.truth.albedo or spec.truth.lights or spec.truth.defocus):
+    if spec.truth is not None and (spec.truth.albedo or spec.truth.lights or spec.truth.defocus
+                                   or spec.truth.boxes):
         extra = {**(extra or {}), **requested_truth_files(spec, built, v, truth)}
     return image, linear, truth, extra
 
 
 def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
-    """The albedo map, the lights document and the circle of confusion of a view, as the spec's
-    ``truth:`` asks (docs/dataset_format.md, "Albedo and light truth", "Defocus truth");
+    """The albedo map, the lights document, the circle of confusion and the boxes of a view, as the
+    spec's ``truth:`` asks (docs/dataset_format.md, "Albedo and light truth", "Defocus truth");
     ``truth``: the view's truth as stored."""
     files = {}
     lens = getattr(built.optics.get(view.camera), "lens", None)
@@ -160,6 +162,9 @@ def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
         files[albedo_path(view.name)] = encode_albedo(built.albedo(built.cameras[view.camera], view.cam_from_world))
     if spec.truth.lights:
         files[lights_path(view.name)] = encode_json(view_lights_document(spec, view))
+    if spec.truth.boxes:  # from the ids as stored and the meshes (docs/dataset_format.md, "Bounding boxes")
+        rel, data = view_boxes_file(spec, built, view, truth)
+        files[rel] = data
     return files
 
 

@@ -1,7 +1,7 @@
 """Per-view truth written only when a spec asks for it (the optional ``truth:`` section): the
 diffuse albedo the renderer used and each image's calibrated lights (photometric stereo), the
-circle of confusion of a thin lens (depth from focus and defocus); docs/dataset_format.md,
-"Albedo and light truth", "Defocus truth"."""
+circle of confusion of a thin lens (depth from focus and defocus), 2D and 3D bounding boxes per
+object; docs/dataset_format.md, "Albedo and light truth", "Defocus truth", "Bounding boxes"."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -18,4 +18,6 @@ class TruthSpec:
     # view, stated in the camera frame (directions, irradiance, positions)
     defocus: bool = param(False, unit="flag", omit_default=True)  # truth/<view>_coc.exr: the
     # thin-lens circle of confusion of each pixel's truth point (cameras with a `lens:`)
+    boxes: bool = param(False, unit="flag", omit_default=True)  # truth/<view>_boxes.json: every
+    # object's visible and amodal 2D boxes and its 3D box in the object frame, with its poses
     where: Where | None = where_field()

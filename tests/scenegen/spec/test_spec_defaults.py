@@ -153,7 +153,7 @@ CASES = [
       for k, v in (("count", 10), ("sigma_px", 1.0), ("outlier_fraction", 0.1),
                    ("near_miss_fraction", 0.3), ("near_miss_px", (1.0, 2.0)))],
     *[(m.TruthSpec, k, CAM + "truth: {}\n", lambda s, k=k: getattr(s.truth, k), v)
-      for k, v in (("albedo", True), ("lights", True), ("defocus", True))],
+      for k, v in (("albedo", True), ("lights", True), ("defocus", True), ("boxes", True))],
     (m.ObjectVariation, "reseed", "objects:\n  - {name: b, shape: blob}\n"
      "variation: {objects: {b: {}}}\n", lambda s: s.variation.objects[0].reseed, True),
     (m.LightVariation, "position_jitter_m", "lights:\n  - {type: point, name: p, "
