@@ -3,11 +3,14 @@ numpy on the stored object-id map (visible boxes), trimesh bounds of the stored 
 into the object frame (3D boxes), OpenCV's projectPoints of the stored meshes' vertices and of the
 8 corners, with the camera's distortion (amodal boxes); a sequence's frames against the poses of
 sequence/objects.json. Tiny renders: 32x24 px, 4 spp."""
+import json
+import shutil
+
 import cv2
 import numpy as np
 import pytest
 
-from scenegen.dataset import Dataset, verify
+from scenegen.dataset import Dataset, DatasetError, verify
 from scenegen.dataset.layout import boxes_path
 from scenegen.geometry.pose import Rigid3
 from scenegen.pipeline.run import render_spec
@@ -85,7 +88,7 @@ def _check_view(ds, view):
     K, dist = camera.to_opencv()
     assert boxes.image_size == (32, 24) and boxes.cam_from_world.allclose(cam_from_world)
     assert [o.name for o in boxes.objects] == [o["name"] for o in ds.objects]
-    seen = 0
+    seen = projected = 0
     for o in boxes.objects:
         # (a) visible: numpy on the ids map
         rows, cols = np.nonzero(ids == o.object_id)
@@ -107,6 +110,7 @@ def _check_view(ds, view):
         world = b.world_from_object.apply(mesh.vertices)
         in_front = (cam_from_world.apply(world)[:, 2] > 0).all()
         if in_front and not o.amodal.vertices_projected < o.amodal.vertices_total:
+            projected += 1
             uv = cv2.projectPoints(world, rvec, cam_from_world.t, K, dist)[0].reshape(-1, 2)
             assert np.allclose(o.amodal.box_xyxy_px, [*uv.min(0), *uv.max(0)], atol=2e-4), o.name
             lo, hi = uv.min(0), uv.max(0)
@@ -123,6 +127,7 @@ def _check_view(ds, view):
             # the corners in the camera frame project (OpenCV) where the camera model puts them
             cuv = cv2.projectPoints(b.corners_world_m, rvec, cam_from_world.t, K, dist)[0].reshape(-1, 2)
             assert np.allclose(camera.project(b.corners_cam_m), cuv, atol=1e-6)
+    assert projected == len(boxes.objects)  # every object in front of the camera: all compared
     return boxes, seen
 
 
@@ -156,3 +161,16 @@ def test_sequence_frames_have_boxes_at_their_time(tmp_path):
         crate.append(boxes.by_name("crate"))
     assert not crate[0].box3d.world_from_object.allclose(crate[1].box3d.world_from_object)
     assert np.array_equal(crate[0].box3d.corners_object_m, crate[1].box3d.corners_object_m)
+
+
+def test_damaged_boxes_file_names_the_file_and_field(still, tmp_path):
+    damaged = tmp_path / "damaged"
+    shutil.copytree(still.root, damaged)
+    view = still.views[0]
+    path = damaged / boxes_path(view)
+    doc = json.loads(path.read_text())
+    doc["objects"][1]["box3d"]["size_m"] = [0.3, 0.3]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(DatasetError, match=rf"{view}_boxes\.json: unreadable boxes of view '{view}': "
+                                           r".*objects\[1\]\.box3d\.size_m: expected"):
+        Dataset(damaged).boxes(view)
