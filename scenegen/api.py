@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Iterable, Mapping, get_args
 
 from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
+from scenegen.assets.libraries import LAYOUTS, LibraryError, check_id, library_file, mesh_within, pick_id
 from scenegen.errors import SpecError
 from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.geometry.pose import Rigid3, look_at
@@ -38,7 +39,7 @@ from scenegen.spec.model import (  # re-exported: the building blocks
     RenderSettings, Rig, RigMember, SceneObject, SceneSpec, Sphere, SpotLight, Texture, Torus,
     Transform, ViewSet,
 )
-from scenegen.spec.model.geometry import AssetFile, Mesh
+from scenegen.spec.model.geometry import AssetFile, LibraryRef, Mesh
 from scenegen.spec.model.lights import Light
 from scenegen.spec.model.materials import Material, PrincipledMaterial
 from scenegen.spec.model.meta import frozen_mapping
@@ -52,7 +53,7 @@ from scenegen.spec.to_yaml import PYTHON_FILE
 
 __all__ = [
     "Scene", "camera", "obj", "render", "to_yaml", "check_spec", "same_spec", "SpecError",
-    "mesh", "image_texture", "sequence", "keyframe", "trajectory", "stereo_rig",
+    "mesh", "library_mesh", "library_picks", "image_texture", "sequence", "keyframe", "trajectory", "stereo_rig",
     "Animation", "JointSpec", "Keyframe", "Mesh", "PrincipledMaterial", "SequenceSpec", "TrackSpec",
     "TrajectoryPath", "TrajectorySpec",
     "AreaLight", "ArucoGridTarget", "Blob", "Box", "CameraSpec", "CharucoTarget", "CheckerboardTarget",
@@ -71,6 +72,33 @@ def mesh(path, *, up_axis: str | None = None) -> Mesh:
     written = str(path)
     return Mesh(path=Path(written), path_as_written=written,
                 up_axis=mesh_up_axis(Path(written).suffix) if up_axis is None else up_axis)
+
+
+def library_mesh(library: str, root, id: str, *, up_axis: str | None = None, scale: float = 1.0) -> Mesh:
+    """Model ``id`` of an asset library folder ``root`` in layout ``library`` ('shapenet',
+    'shapenet_v1', 'gso', 'objaverse'; docs/scene_spec.md "Asset libraries"), as the YAML's
+    ``mesh: {library:, root:, id:}``: a relative root resolves against ``Scene(base_dir=...)``;
+    ``up_axis`` defaults to the layout's, ``scale`` (metres per file unit) to 1."""
+    if library not in LAYOUTS:
+        raise SpecError(f"unknown library layout {library!r}; expected one of {', '.join(LAYOUTS)}",
+                        file=PYTHON_FILE, field="library_mesh.library")
+    try:
+        check_id(LAYOUTS[library], id)
+    except LibraryError as e:
+        raise SpecError(str(e), file=PYTHON_FILE, field="library_mesh.id") from None
+    written = f"{str(root).rstrip('/')}/{LAYOUTS[library].pattern.format(id=id)}"
+    return Mesh(path=Path(written), path_as_written=written, scale=float(scale),
+                up_axis=LAYOUTS[library].up_axis if up_axis is None else up_axis,
+                library=LibraryRef(layout=library, root=str(root), id=id))
+
+
+def library_picks(library: str, root, category: str, count: int, seed: int = 0) -> tuple[str, ...]:
+    """``count`` distinct model ids of ``category`` (a ShapeNet synset) picked by ``seed``: picks
+    0 .. count-1 of the YAML's ``{category:, pick:, seed:}`` (``root`` as a path from here)."""
+    try:
+        return tuple(pick_id(library, Path(root), category, k, seed) for k in range(int(count)))
+    except LibraryError as e:
+        raise SpecError(str(e), file=PYTHON_FILE, field=f"library_picks.{e.key}") from None
 
 
 def image_texture(path) -> Texture:
@@ -226,7 +254,11 @@ def _resolved_paths(x, base: Path, field: str):
     out = dataclasses.replace(x, **changes) if changes else x
     if isinstance(out, Mesh):
         try:
-            scan = scan_mesh_file(out.path)
+            if out.library is not None:  # every path built from the id checked inside the root
+                library_file(out.library.layout, (base / Path(out.library.root).expanduser()).resolve(), out.library.id)
+            scan = scan_mesh_file(out.path, mesh_within(out))
+        except LibraryError as e:
+            raise SpecError(str(e), file=PYTHON_FILE, field=f"{field}.{e.key}") from None
         except AssetFileError as e:
             raise SpecError(f"{e.message} (the mesh of {PYTHON_FILE}: {field})", file=str(e.file), line=e.line) \
                 from None

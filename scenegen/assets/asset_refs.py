@@ -59,15 +59,17 @@ class AssetScan:
         return bool(self.materials) or self.vertex_colors
 
 
-def checked_ref(written: str, asset_dir: Path, source: Path, line: int | None, key: str) -> AssetRef:
-    """A file name read from ``source`` checked against the asset's folder ``asset_dir``."""
+def checked_ref(written: str, asset_dir: Path, source: Path, line: int | None, key: str,
+                within: Path | None = None) -> AssetRef:
+    """A file name read from ``source``, relative to ``asset_dir``, checked to lie inside
+    ``within`` (default ``asset_dir``; a library model's folder, :mod:`scenegen.assets.libraries`)."""
     where = lambda msg: AssetFileError(f"{key} {written!r}: {msg}", source, line)
     if not written.strip():
         raise where("expected a file name, got nothing")
     if _URI_SCHEME.match(written) or written.startswith(("/", "\\")) or Path(written).is_absolute():
         raise where("expected a path relative to the asset's folder (no absolute path or URL)")
-    root = asset_dir.resolve()
-    full = (root / written).resolve()
+    root = (asset_dir if within is None else within).resolve()
+    full = (asset_dir.resolve() / written).resolve()
     if full != root and root not in full.parents:
         raise where(f"leaves the asset's folder {str(root)!r}; asset files may only name files "
                     "inside it")
@@ -76,13 +78,13 @@ def checked_ref(written: str, asset_dir: Path, source: Path, line: int | None, k
     return AssetRef(full, written, source, line, key)
 
 
-def scan_mesh_file(path: Path) -> AssetScan:
-    """The files named by a mesh file (checked) and its own materials; nothing for PLY/STL but
-    vertex colours."""
+def scan_mesh_file(path: Path, within: Path | None = None) -> AssetScan:
+    """The files named by a mesh file (checked: inside ``within``, default the mesh's folder) and
+    its own materials; nothing for PLY/STL but vertex colours."""
     path = Path(path)
     ext = path.suffix.lower()
     if ext == ".obj":
-        return _scan_obj(path)
+        return _scan_obj(path, within)
     if ext in (".gltf", ".glb"):
         return _scan_gltf(path)
     if ext == ".ply":
@@ -98,15 +100,15 @@ def _lines(path: Path):
                 yield n, line
 
 
-def _scan_obj(path: Path) -> AssetScan:
+def _scan_obj(path: Path, within: Path | None = None) -> AssetScan:
     refs, names, colors = [], [], False
     for n, line in _lines(path):
         head, _, rest = line.partition(" ")
         if head == "mtllib":
             for written in mtllib_names(rest.strip(), path.parent):
-                ref = checked_ref(written, path.parent, path, n, "mtllib")
+                ref = checked_ref(written, path.parent, path, n, "mtllib", within)
                 refs.append(ref)
-                mtl_refs, mtl_names = scan_mtl(ref.path, path.parent)
+                mtl_refs, mtl_names = scan_mtl(ref.path, path.parent, within)
                 refs.extend(mtl_refs)
                 names.extend(mtl_names)
         elif head == "v" and len(rest.split()) >= 6:
@@ -141,7 +143,7 @@ def _check_numbers(key: str, args: list[str], mtl: Path, n: int) -> None:
                              f"got {' '.join(args) or 'nothing'!r}", mtl, n)
 
 
-def scan_mtl(mtl: Path, asset_dir: Path) -> tuple[list[AssetRef], list[str]]:
+def scan_mtl(mtl: Path, asset_dir: Path, within: Path | None = None) -> tuple[list[AssetRef], list[str]]:
     """(texture files named by an MTL file, checked; its material names in order); the numbers
     of Kd, Ks, Ke, Ns, d and Tr are checked too."""
     refs, names = [], []
@@ -155,7 +157,7 @@ def scan_mtl(mtl: Path, asset_dir: Path) -> tuple[list[AssetRef], list[str]]:
         elif key.lower() in MTL_MAP_KEYS:
             if len(parts) < 2:
                 raise AssetFileError(f"{key}: expected a file name", mtl, n)
-            refs.append(checked_ref(parts[-1], asset_dir, mtl, n, key))
+            refs.append(checked_ref(parts[-1], asset_dir, mtl, n, key, within))
     return refs, names
 
 

@@ -119,8 +119,9 @@ def gltf_material(mat, name: str) -> AssetMaterial:
         double_sided=bool(mat.doubleSided))
 
 
-def parse_mtl(mtl: Path, asset_dir: Path) -> dict[str, AssetMaterial]:
-    """Every material of an MTL file, by name (maps resolved and checked inside ``asset_dir``)."""
+def parse_mtl(mtl: Path, asset_dir: Path, within: Path | None = None) -> dict[str, AssetMaterial]:
+    """Every material of an MTL file, by name (maps resolved against ``asset_dir``, checked
+    inside ``within``, default ``asset_dir``)."""
     raw: dict[str, dict] = {}
     cur = None
     with open(mtl, "r", encoding="utf-8", errors="replace") as fh:
@@ -141,7 +142,7 @@ def parse_mtl(mtl: Path, asset_dir: Path) -> dict[str, AssetMaterial]:
             elif k in ("ns", "d", "tr") and args:
                 cur[k] = float(args[0])
             elif k in ("map_kd", "map_d", "map_bump", "bump", "norm", "map_ke") and args:
-                cur[k] = checked_ref(args[-1], asset_dir, mtl, n, key).path
+                cur[k] = checked_ref(args[-1], asset_dir, mtl, n, key, within).path
                 if k in ("map_bump", "bump") and "-bm" in args:
                     cur["bm"] = float(args[args.index("-bm") + 1])
     return {name: _mtl_material(name, r) for name, r in raw.items()}
@@ -167,15 +168,15 @@ def _mtl_material(name: str, r: dict) -> AssetMaterial:
         emissive_texture=load_image(r["map_ke"]) if "map_ke" in r else None)
 
 
-def _obj_materials(path: Path) -> dict[str, AssetMaterial]:
+def _obj_materials(path: Path, within: Path | None = None) -> dict[str, AssetMaterial]:
     out: dict[str, AssetMaterial] = {}
     with open(path, "r", encoding="utf-8", errors="replace") as fh:
         for n, line in enumerate(fh, start=1):
             parts = line.split("#", 1)[0].split()
             if parts[:1] == ["mtllib"]:
                 for written in mtllib_names(" ".join(parts[1:]), path.parent):
-                    mtl = checked_ref(written, path.parent, path, n, "mtllib").path
-                    out.update(parse_mtl(mtl, path.parent))
+                    mtl = checked_ref(written, path.parent, path, n, "mtllib", within).path
+                    out.update(parse_mtl(mtl, path.parent, within))
     return out
 
 
@@ -186,10 +187,11 @@ def _vertex_colors(visual) -> np.ndarray | None:
     return linear_from_srgb(c).astype(np.float32)
 
 
-def mesh_parts(path) -> list[MeshPart]:
-    """The parts of a mesh file with their own materials (see the module docstring)."""
+def mesh_parts(path, within: Path | None = None) -> list[MeshPart]:
+    """The parts of a mesh file with their own materials (see the module docstring); the files
+    it names must lie inside ``within`` (default its folder)."""
     path = Path(path)
-    mtl = _obj_materials(path) if path.suffix.lower() == ".obj" else {}
+    mtl = _obj_materials(path, within) if path.suffix.lower() == ".obj" else {}
     scene = trimesh.load_scene(str(path), process=False)
     parts, v0, f0 = [], 0, 0
     for node in scene.graph.nodes_geometry:  # the order of shapes.load_mesh

@@ -20,20 +20,21 @@ OBJECT_MESHES = {
     "cylinder": lambda g: shapes.cylinder(g.radius, g.height),
     "torus": lambda g: shapes.torus(g.major_radius, g.minor_radius),
     "blob": lambda g: cached_blob(g.radius, g.amplitude, g.frequency, g.seed, g.subdivisions),
-    "mesh": lambda g: file_mesh(g.path, g.up_axis),
+    "mesh": lambda g: file_mesh(g.path, g.up_axis, getattr(g, "scale", 1.0)),
 }
 TARGET_KINDS = ("checkerboard", "charuco", "aruco_grid")
 #: Kinds whose shading normals are interpolated (curved surfaces approximated by triangles).
 SMOOTH_KINDS = ("cylinder", "torus", "blob", "sphere")
 
 
-def file_mesh(path, up_axis: str) -> trimesh.Trimesh:
+def file_mesh(path, up_axis: str, scale: float = 1.0) -> trimesh.Trimesh:
     """A mesh file in our Z-up object frame: a Y-up file (glTF) turned by the one conversion of
-    :func:`scenegen.geometry.conventions.zup_from_mesh_file` (UVs kept)."""
+    :func:`scenegen.geometry.conventions.zup_from_mesh_file`, then times ``scale`` (metres per
+    file unit; UVs kept)."""
     mesh = shapes.load_mesh(path)
-    if up_axis == "z":
+    if up_axis == "z" and scale == 1.0:
         return mesh
-    return trimesh.Trimesh(vertices=zup_from_mesh_file(mesh.vertices, up_axis), faces=mesh.faces,
+    return trimesh.Trimesh(vertices=zup_from_mesh_file(mesh.vertices, up_axis) * float(scale), faces=mesh.faces,
                            visual=mesh.visual, process=False)
 
 

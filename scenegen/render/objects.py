@@ -13,6 +13,7 @@ import numpy as np
 import trimesh
 
 from scenegen.assets import meshes, shapes
+from scenegen.assets.libraries import mesh_within
 from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
@@ -106,7 +107,7 @@ def _own_material_parts(obj, key: str, built) -> dict:
     world = meshes.place(local, obj.transform)
     built.meshes_world[obj.name] = world
     smooth = meshes.is_smooth(obj.geometry, local, world)
-    parts = mesh_parts(obj.geometry.path)
+    parts = mesh_parts(obj.geometry.path, mesh_within(obj.geometry))
     if sum(p.vertex_count for p in parts) != len(world.vertices) or \
             sum(p.face_count for p in parts) != len(world.faces):
         raise ValueError(f"object {obj.name!r}: the parts of {obj.geometry.path_as_written!r} do not "

@@ -11,6 +11,7 @@ from contextlib import contextmanager
 
 from scenegen.assets import meshes
 from scenegen.assets.envmap import check_envmap
+from scenegen.assets.libraries import mesh_within
 from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.errors import SpecError
 
@@ -32,7 +33,7 @@ def check_assets(spec) -> None:
         with located(obj, f"object {obj.name!r}"):
             meshes.object_mesh(obj.geometry)
             if obj.geometry.kind == "mesh" and obj.geometry.own_materials:  # render's condition
-                mesh_parts(obj.geometry.path)  # the MTL's / glTF's images, as render reads them
+                mesh_parts(obj.geometry.path, mesh_within(obj.geometry))  # the MTL's / glTF's images, as render reads them
         texture = getattr(obj.material, "texture", None)
         if texture is not None:
             with located(texture if getattr(texture, "where", None) else obj, f"object {obj.name!r} texture"):

@@ -80,9 +80,12 @@ def _material(mat) -> dict:
 def _geometry(g) -> tuple[str, Any]:
     if isinstance(g, m.Mesh):
         path = g.path_as_written or str(g.path)
-        if g.up_axis == mesh_up_axis(Path(path).suffix):
+        extra = {"up_axis": g.up_axis, **({"scale": g.scale} if g.scale != 1.0 else {})}
+        if g.library is not None:
+            return "mesh", {"library": g.library.layout, "root": g.library.root, "id": g.library.id, **extra}
+        if g.up_axis == mesh_up_axis(Path(path).suffix) and g.scale == 1.0:
             return "mesh", path
-        return "mesh", {"path": path, "up_axis": g.up_axis}
+        return "mesh", {"path": path, **extra}
     return "target" if g.kind in m.TARGET_KINDS else "shape", {"type": g.kind, **write_fields(g)}
 
 

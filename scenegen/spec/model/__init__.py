@@ -28,7 +28,7 @@ from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
 from scenegen.spec.model.crossview import CROSSVIEW_PAIR_MODES, CrossviewSpec, MatchSetSpec
 from scenegen.spec.model.geometry import (
     ARUCO_DICTIONARIES, MESH_SUFFIXES, AssetFile, SHAPE_KINDS, TARGET_KINDS, ArucoGridTarget, Blob, Box,
-    CharucoTarget, CheckerboardTarget, Cylinder, Mesh, Plane, SceneObject, Shape, Sphere, Target,
+    CharucoTarget, CheckerboardTarget, Cylinder, LibraryRef, Mesh, Plane, SceneObject, Shape, Sphere, Target,
     Torus, Transform,
 )
 from scenegen.spec.model.lights import (
@@ -61,7 +61,7 @@ __all__ = [
     "RIG_TYPES", "CameraSpec", "Rig", "RigMember",
     "CROSSVIEW_PAIR_MODES", "CrossviewSpec", "MatchSetSpec",
     "ARUCO_DICTIONARIES", "MESH_SUFFIXES", "SHAPE_KINDS", "TARGET_KINDS", "ArucoGridTarget", "Blob",
-    "Box", "CharucoTarget", "CheckerboardTarget", "Cylinder", "Mesh", "Plane", "SceneObject",
+    "Box", "CharucoTarget", "CheckerboardTarget", "Cylinder", "LibraryRef", "Mesh", "Plane", "SceneObject",
     "Shape", "Sphere", "Target", "Torus", "Transform",
     "BEAM_WIDTH_FRACTION", "LIGHT_TYPES", "AreaLight", "ConstantLight", "EnvmapLight", "Light",
     "PointLight", "SpotLight", "DirectionalLight",

@@ -8,6 +8,7 @@ from typing import Any, Union
 
 import numpy as np
 
+from scenegen.assets.libraries import LIBRARY_LAYOUTS
 from scenegen.errors import Where
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec.model.materials import Material
@@ -94,6 +95,16 @@ class AssetFile:
 
 
 @dataclass(frozen=True, kw_only=True)
+class LibraryRef:
+    """A model of an asset library folder (scenegen.assets.libraries): the mesh's path is the
+    layout's pattern filled with the id, inside the root."""
+
+    layout: str = param(unit="library layout", choices=LIBRARY_LAYOUTS, key="library")
+    root: str = part(unit="the library's folder as written (relative to the spec file)")
+    id: str = part(unit="model id ('<synset>/<model_id>' for ShapeNet, a name for GSO and Objaverse)")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Mesh:
     path: Path = part(unit="absolute path of a .ply/.obj/.glb/.gltf/.stl file (trimesh)")
     path_as_written: str = part(unit="the path as in the spec (relative to the spec file)")
@@ -104,6 +115,11 @@ class Mesh:
     up_axis: str = param("z", unit="axis", choices=MESH_UP_AXES, omit_default=True,
                          derived="'y' for .gltf/.glb (the glTF 2.0 spec), else 'z'")  # the file's
     # up axis; a Y-up file is turned into our Z-up object frame (scenegen.geometry.conventions)
+    scale: float = param(1.0, unit="metres per file unit", lo=0.0, lo_open=True, omit_default=True)
+    # uniform, applied to the file's vertices before the object's transform (ShapeNet's unit
+    # diagonal -> the real diagonal in metres)
+    library: LibraryRef | None = part(None, unit="the asset library model the file is (None: a "
+                                      "path)", omit_default=True)
     kind: str = field(default="mesh", init=False)
 
 

@@ -13,6 +13,7 @@ from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.fields import check_keys, read_fields
+from scenegen.spec.parse.library import library_model
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
 from scenegen.spec.parse.read import read_float, read_int, seed_or_none
@@ -50,19 +51,28 @@ def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
 
 
 def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
-    """A mesh file, the files it names (each checked: inside the mesh's folder, existing; an
-    error names the asset file and line) and whether its own materials are rendered: yes when
-    the file has materials and the object gives none; a `material:` replaces them, with a
-    warning."""
-    up_node = None
-    if node.is_mapping:  # `mesh: {path: ..., up_axis: y}`
-        f = node.as_mapping("a mesh (a file path, or a mapping with 'path' and 'up_axis')")
-        f.check(required=("path",), optional=("up_axis",))
-        up_node, node = f.get("up_axis"), f.get("path")
-    path, written = node.as_path(mg.MESH_SUFFIXES, "mesh")
-    up_axis = mesh_up_axis(path.suffix) if up_node is None else up_node.as_enum(mg.MESH_UP_AXES, "up axis")
+    """A mesh file (or an asset library's model, :mod:`.library`), the files it names (each
+    checked: inside the mesh's folder -- a library model's folder --, existing; an error names
+    the asset file and line) and whether its own materials are rendered: yes when the file has
+    materials and the object gives none; a `material:` replaces them, with a warning."""
+    up_node = scale_node = library = None
+    within = None
+    if node.is_mapping:  # `mesh: {path: ..., up_axis: y}` or `mesh: {library: ..., root: ..., id: ...}`
+        f = node.as_mapping("a mesh (a file path, or a mapping with 'path' or 'library')")
+        up_node, scale_node = f.get("up_axis"), f.get("scale")
+        if "library" in f:
+            lib, library, written, up_default = library_model(f, node, ctx)
+            path, within = lib.path, lib.asset_dir
+        else:
+            f.check(required=("path",), optional=("up_axis", "scale"))
+            node = f.get("path")
+    if library is None:
+        path, written = node.as_path(mg.MESH_SUFFIXES, "mesh")
+        up_default = mesh_up_axis(path.suffix)
+    up_axis = up_default if up_node is None else up_node.as_enum(mg.MESH_UP_AXES, "up axis")
+    scale = 1.0 if scale_node is None else scale_node.as_float("metres per file unit", lo=0.0, lo_open=True)
     try:
-        scan = scan_mesh_file(path)
+        scan = scan_mesh_file(path, within)
     except AssetFileError as e:
         raise SpecError(f"{e.message} (the mesh of {node.where})", file=str(e.file),
                         line=e.line) from None
@@ -72,7 +82,8 @@ def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
         ctx.warn(mat_node, f"the mesh {written!r} has its own materials ({what}); this "
                  "`material:` replaces them all (leave it out to render the file's materials)")
     return mg.Mesh(path=path, path_as_written=written, files=files,
-                   own_materials=scan.has_materials and mat_node is None, up_axis=up_axis)
+                   own_materials=scan.has_materials and mat_node is None, up_axis=up_axis,
+                   scale=scale, library=library)
 
 
 def object_material(mat_node: Node | None, node: Node, materials: Mapping[str, Material],

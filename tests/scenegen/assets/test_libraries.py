@@ -1,0 +1,114 @@
+"""Asset library folders (scenegen.assets.libraries, docs/scene_spec.md "Asset libraries"): tiny
+synthetic libraries in each layout (OBJ + MTL + PNG in ShapeNet's and Google Scanned Objects'
+folders, a glb in an Objaverse-style folder) parsed, placed with their axis and scale
+conventions (world bounds against trimesh's own reading of the file and the rotation written out
+here), picked by seed, hostile ids refused with exit status 2, and rendered with their textures."""
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import trimesh
+import yaml
+from PIL import Image
+
+from scenegen import api
+from scenegen.assets import meshes
+from scenegen.assets.libraries import LAYOUTS, LibraryError, library_file, pick_id
+from scenegen.cli import main
+from scenegen.errors import SpecError
+from scenegen.geometry.color import linear_from_srgb
+from scenegen.spec import load_spec, parse_spec, same_spec, spec_to_dict, to_yaml
+
+SYNSET, CAR = "02958343", "1a0bc9ab92c915167ae33d942430658c"
+GSO_NAME, UID = "Android_Figure_Panda", "8476c4170df24cf5bbe6967222d1a42d"
+SHAPENET_SRGB, GSO_SRGB, GLB_SRGB = (200, 60, 40), (40, 180, 60), (50, 90, 210)
+# the file's quads: ShapeNet (Y-up) at file y = 0.25, x in [-0.3, 0.3], z in [-0.2, 0.1];
+# GSO (Z-up) at z = 0.1, x in [-0.2, 0.2], y in [-0.1, 0.3]; glb (Y-up) at y = 0, x, z in [0, 0.5]
+SHAPENET_QUAD = [[-0.3, 0.25, 0.1], [0.3, 0.25, 0.1], [0.3, 0.25, -0.2], [-0.3, 0.25, -0.2]]
+GSO_QUAD = [[-0.2, -0.1, 0.1], [0.2, -0.1, 0.1], [0.2, 0.3, 0.1], [-0.2, 0.3, 0.1]]
+GLB_QUAD = [[0, 0, 0.5], [0.5, 0, 0.5], [0.5, 0, 0], [0, 0, 0]]
+#: Y-up file -> our Z-up world, written out: +90 degrees about x, (x, y, z) -> (x, -z, y)
+ROT_X90 = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+
+
+def _png(path: Path, srgb) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(path), np.full((4, 4, 3), srgb[::-1], np.uint8))
+
+
+def _obj(path: Path, quad, mtl: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    v = "".join(f"v {x} {y} {z}\n" for x, y, z in quad)
+    # winding: the face's normal points up in the file's own up axis
+    path.write_text(f"mtllib {mtl}\n{v}vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
+
+
+def write_shapenet(root: Path, model: str = CAR, synset: str = SYNSET, srgb=SHAPENET_SRGB) -> Path:
+    """ShapeNetCore v2: <synset>/<model>/models/model_normalized.{obj,mtl}, the MTL naming
+    ../images/texture0.png as ShapeNet's do."""
+    m = root / synset / model
+    _obj(m / "models/model_normalized.obj", SHAPENET_QUAD, "model_normalized.mtl")
+    (m / "models/model_normalized.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd ../images/texture0.png\n")
+    _png(m / "images/texture0.png", srgb)
+    return m
+
+
+def write_gso(root: Path, name: str = GSO_NAME) -> Path:
+    """Google Scanned Objects: <name>/meshes/model.{obj,mtl}, materials/textures/texture.png."""
+    m = root / name
+    _obj(m / "meshes/model.obj", GSO_QUAD, "model.mtl")
+    (m / "meshes/model.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd ../materials/textures/texture.png\n")
+    _png(m / "materials/textures/texture.png", GSO_SRGB)
+    return m
+
+
+def write_objaverse(root: Path, uid: str = UID) -> Path:
+    """An Objaverse-style folder: <uid>.glb (Y-up, a base colour texture, metallic 0, roughness 1)."""
+    root.mkdir(parents=True, exist_ok=True)
+    m = trimesh.Trimesh(vertices=GLB_QUAD, faces=[[0, 1, 2], [0, 2, 3]], process=False)
+    mat = trimesh.visual.material.PBRMaterial(
+        baseColorTexture=Image.fromarray(np.full((4, 4, 3), GLB_SRGB, np.uint8)), metallicFactor=0.0, roughnessFactor=1.0)
+    m.visual = trimesh.visual.TextureVisuals(uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), material=mat)
+    m.export(root / f"{uid}.glb")
+    return root / f"{uid}.glb"
+
+
+def libraries(tmp_path: Path) -> Path:
+    write_shapenet(tmp_path / "ShapeNetCore.v2")
+    write_gso(tmp_path / "gso")
+    write_objaverse(tmp_path / "objaverse")
+    return tmp_path
+
+
+def spec_text(mesh: dict, extra: str = "") -> str:
+    return yaml.safe_dump({"name": "lib", "objects": [{"name": "a", "mesh": mesh}],
+                           "cameras": {"cam": {"size": [32, 24], "fov_deg": 60}},
+                           "views": [{"camera": "cam", "look_at": [{"eye": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0]}]}]},
+                          sort_keys=False) + extra
+
+
+def _parse(tmp_path, mesh):
+    return parse_spec(spec_text(mesh), file=str(tmp_path / "spec.yaml"), base_dir=tmp_path)
+
+
+@pytest.mark.parametrize("layout, root, model_id, rot, scale, bounds", [
+    # ShapeNet: file y (up) -> z, file -z (its front) -> +y; x2: z = 0.5, y in [-0.2, 0.4]
+    ("shapenet", "ShapeNetCore.v2", f"{SYNSET}/{CAR}", ROT_X90, 2.0, [[-0.6, -0.2, 0.5], [0.6, 0.4, 0.5]]),
+    ("gso", "gso", GSO_NAME, np.eye(3), 1.0, [[-0.2, -0.1, 0.1], [0.2, 0.3, 0.1]]),  # Z-up metres: as stored
+    ("objaverse", "objaverse", UID, ROT_X90, 0.5, [[0.0, -0.25, 0.0], [0.25, 0.0, 0.0]]),  # glTF floor -> z = 0
+])
+def test_each_layout_reads_its_file_with_its_axes_and_scale(tmp_path, layout, root, model_id, rot, scale, bounds):
+    libraries(tmp_path)
+    spec = _parse(tmp_path, {"library": layout, "root": root, "id": model_id, "scale": scale})
+    g = spec.objects[0].geometry
+    assert g.path == library_file(layout, tmp_path / root, model_id).path
+    assert g.own_materials and g.up_axis == LAYOUTS[layout].up_axis
+    local, _ = meshes.object_mesh(g)
+    np.testing.assert_allclose(local.bounds, bounds, atol=1e-12)
+    # independent: trimesh's own reading of the file, the rotation written out above, the scale
+    raw = trimesh.load(str(g.path), force="mesh", process=False)
+    np.testing.assert_allclose(local.vertices, (np.asarray(raw.vertices) @ rot.T) * scale, atol=1e-12)
+    assert spec_to_dict(spec)["objects"][0]["geometry"]["library"] == {"layout": layout, "root": root, "id": model_id}
+    assert same_spec(spec, parse_spec(to_yaml(spec), file="x.yaml", base_dir=tmp_path))
