@@ -112,3 +112,92 @@ def test_each_layout_reads_its_file_with_its_axes_and_scale(tmp_path, layout, ro
     np.testing.assert_allclose(local.vertices, (np.asarray(raw.vertices) @ rot.T) * scale, atol=1e-12)
     assert spec_to_dict(spec)["objects"][0]["geometry"]["library"] == {"layout": layout, "root": root, "id": model_id}
     assert same_spec(spec, parse_spec(to_yaml(spec), file="x.yaml", base_dir=tmp_path))
+
+
+def _validate(tmp_path, mesh, capsys) -> tuple[int, str]:
+    (tmp_path / "spec.yaml").write_text(spec_text(mesh))
+    capsys.readouterr()
+    rc = main(["validate", str(tmp_path / "spec.yaml")])
+    return rc, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("mesh, words", [
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"{SYNSET}/../../../etc"}, "plain names"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"../{SYNSET}"}, "plain names"),
+    ({"library": "gso", "root": "gso", "id": "/etc/passwd"}, "plain names"),
+    ({"library": "gso", "root": "gso", "id": "http://example.com/x"}, "plain names"),
+    ({"library": "gso", "root": "gso", "id": "a\\..\\b"}, "plain names"),
+    ({"library": "gso", "root": "gso", "id": f"{GSO_NAME}/meshes"}, "1 part"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "id": CAR}, "2 parts"),
+    ({"library": "gso", "root": "gso", "id": "No_Such_Thing"}, "file not found"),
+    ({"library": "gso", "root": "nowhere", "id": GSO_NAME}, "no such folder"),
+    ({"library": "gso", "root": "gso", "id": "escape"}, "leaves the library root"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "category": "..", "pick": 0}, "plain names"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "category": SYNSET, "pick": 5}, "holds 1 models"),
+    ({"library": "gso", "root": "gso", "category": "x"}, "has no categories"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"{SYNSET}/{CAR}", "pick": 1}, "goes with 'category'"),
+    ({"library": "blender", "root": "gso", "id": GSO_NAME}, "library layout"),
+])
+def test_hostile_ids_are_refused_with_file_line_and_exit_status_2(tmp_path, capsys, mesh, words):
+    libraries(tmp_path)
+    outside = tmp_path / "outside"
+    write_gso(outside, "escape")
+    os.symlink(outside / "escape", tmp_path / "gso" / "escape")  # a link out of the root
+    rc, err = _validate(tmp_path, mesh, capsys)
+    assert rc == 2, err
+    line = err.strip().splitlines()[-1]
+    assert line.startswith(f"scenegen: error: {tmp_path / 'spec.yaml'}:") and "objects[0].mesh." in line and words in line, line
+    assert "Traceback" not in err
+
+
+def test_a_shapenet_mtl_naming_a_file_outside_the_model_folder_is_refused(tmp_path, capsys):
+    m = write_shapenet(tmp_path / "lib")
+    (m / "models/model_normalized.mtl").write_text("newmtl m\nmap_Kd ../../../secret.png\n")
+    _png(tmp_path / "secret.png", (1, 2, 3))
+    rc, err = _validate(tmp_path, {"library": "shapenet", "root": "lib", "id": f"{SYNSET}/{CAR}"}, capsys)
+    assert rc == 2 and "model_normalized.mtl:2: map_Kd '../../../secret.png': leaves" in err, err
+
+
+def test_picks_by_seed_are_distinct_models_recorded_by_id(tmp_path):
+    root = tmp_path / "lib"
+    models = [f"{k:032x}" for k in range(6)]
+    for mid in models:
+        write_shapenet(root, mid)
+    write_shapenet(root, "other", synset="03001627")
+    picks = [pick_id("shapenet", root, SYNSET, k, 7) for k in range(6)]
+    assert sorted(picks) == [f"{SYNSET}/{m}" for m in models]  # a permutation: all distinct
+    assert picks == [pick_id("shapenet", root, SYNSET, k, 7) for k in range(6)]  # seeded
+    assert picks != [pick_id("shapenet", root, SYNSET, k, 8) for k in range(6)]
+    order = np.random.default_rng(7).permutation(6)  # the documented rule, written out
+    assert picks == [f"{SYNSET}/{models[i]}" for i in order]
+    objs = [{"name": f"car{k}", "mesh": {"library": "shapenet", "root": "lib", "category": SYNSET, "pick": k}}
+            for k in range(3)]
+    text = yaml.safe_dump({"name": "cars", "seed": 3, "objects": objs})
+    spec = parse_spec(text, file="s.yaml", base_dir=tmp_path)
+    ids = [o.geometry.library.id for o in spec.objects]
+    assert len(set(ids)) == 3  # one seed for the category: picks 0, 1, 2 differ
+    assert [spec_to_dict(spec)["objects"][k]["geometry"]["library"]["id"] for k in range(3)] == ids
+    again = parse_spec(to_yaml(spec), file="s.yaml", base_dir=tmp_path)  # written back by id
+    assert same_spec(spec, again)
+    assert api.library_picks("shapenet", root, SYNSET, 3, seed=7) == tuple(picks[:3])
+
+
+def test_the_python_api_builds_the_same_spec_as_the_yaml(tmp_path):
+    libraries(tmp_path)
+    spec = api.Scene("lib", base_dir=tmp_path, objects=[
+        api.obj("a", api.library_mesh("shapenet", "ShapeNetCore.v2", f"{SYNSET}/{CAR}", scale=2.0))],
+        cameras=[api.camera("cam", size=(32, 24), fov_deg=60)],
+        views=[api.ViewSet(name=None, camera="cam", rig=None, placement=api.LookAtList(entries=(
+            api.LookAt(eye=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)),)))])
+    yaml_spec = _parse(tmp_path, {"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"{SYNSET}/{CAR}", "scale": 2})
+    assert spec_to_dict(spec)["objects"][0]["geometry"] == spec_to_dict(yaml_spec)["objects"][0]["geometry"]
+    with pytest.raises(SpecError, match="library_mesh.id: .*plain names"):
+        api.library_mesh("gso", "gso", "../x")
+    with pytest.raises(SpecError, match="unknown library layout"):
+        api.library_mesh("blender", "gso", "x")
+
+
+def test_library_errors_name_the_key():
+    with pytest.raises(LibraryError) as e:
+        library_file("gso", Path("/nonexistent-root"), GSO_NAME)
+    assert e.value.key == "root"
