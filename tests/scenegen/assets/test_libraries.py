@@ -201,3 +201,46 @@ def test_library_errors_name_the_key():
     with pytest.raises(LibraryError) as e:
         library_file("gso", Path("/nonexistent-root"), GSO_NAME)
     assert e.value.key == "root"
+
+
+@pytest.mark.render
+def test_a_model_of_each_layout_renders_its_own_texture(tmp_path, capsys):
+    """Three library models side by side under a uniform white sky, seen from above: each
+    object's mean linear colour over its inner pixels is its texture's (Lambertian OBJ texel within 5 %; the glTF's
+    principled surface a x texel + b, a near 1, b small) and each lies where its axes put it."""
+    from scenegen.dataset import Dataset
+    libraries(tmp_path)
+    objects = [
+        {"name": "car", "mesh": {"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"{SYNSET}/{CAR}"},
+         "transform": {"translation": [-0.75, 0, -0.25]}},
+        {"name": "panda", "mesh": {"library": "gso", "root": "gso", "id": GSO_NAME, "scale": 1.5},
+         "transform": {"translation": [0, -0.15, 0]}},
+        {"name": "thing", "mesh": {"library": "objaverse", "root": "objaverse", "id": UID},
+         "transform": {"translation": [0.5, 0.25, 0]}},
+    ]
+    text = yaml.safe_dump({"name": "lib", "render": {"spp": 4}, "objects": objects,
+                           "lights": [{"type": "constant", "radiance": 1.0}],
+                           "cameras": {"cam": {"size": [32, 24], "fov_deg": 60}},
+                           "views": [{"camera": "cam", "look_at": [{"eye": [0, 0, 2], "target": [0, 0, 0], "up": [0, 1, 0]}]}]},
+                          sort_keys=False)
+    (tmp_path / "lib.yaml").write_text(text)
+    assert main(["render", str(tmp_path / "lib.yaml"), "-o", str(tmp_path / "out"), "--quiet"]) == 0, capsys.readouterr().err
+    ds = Dataset(tmp_path / "out")
+    view = ds.views[0]
+    img, truth = ds.linear_image(view), ds.truth(view)
+    texels = [linear_from_srgb(np.array(c) / 255.0) for c in (SHAPENET_SRGB, GSO_SRGB, GLB_SRGB)]
+    for oid, texel in zip((1, 2, 3), texels):
+        # inner pixels only (no background mixed in at the edges), averaged: the estimator is
+        # unbiased but noisy at 4 spp, and a median of a skewed few dozen samples is not
+        mask = cv2.erode((truth["object_id"] == oid).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        assert mask.sum() >= 12, (oid, mask.sum())
+        got = img[mask].mean(axis=0)
+        print(f"object {oid}: {mask.sum()} inner pixels, rendered / texel {np.round(got / texel, 4).tolist()}")
+        if oid < 3:  # measured 1.0045 (ShapeNet), 0.9852 (GSO)
+            assert np.max(np.abs(got - texel) / texel) < 0.05, (oid, got, texel)
+        else:
+            a, b = np.polyfit(texel, got, 1)
+            assert 0.95 < a < 1.15 and 0.0 <= b < 0.03, (a, b, got, texel)
+    # the world meshes the dataset stores are where the axes put them (car at z = 0.25 - 0.25)
+    car = trimesh.load(str(tmp_path / "out/scene/meshes/car.ply"), process=False)
+    np.testing.assert_allclose(car.bounds, [[-1.05, -0.1, 0.0], [-0.45, 0.2, 0.0]], atol=1e-6)
