@@ -221,6 +221,15 @@ def depth_z_from_range(range_m, rays_z1):
     return np.asarray(range_m) / np.linalg.norm(np.asarray(rays_z1), axis=-1)
 
 
+#: The ``rotation_z_deg`` of an envmap light that shows an equirectangular image as Blender's world
+#: Environment Texture does (Poly Haven's HDRIs are made and previewed there). Cycles maps a
+#: direction d (Blender's world: Z-up, as ours) to u = 0.5 - atan2(d_y, d_x) / 2 pi, v = 1 -
+#: acos(d_z) / pi with v = 0 at the image's bottom row (``direction_to_equirectangular``), so the
+#: image centre looks along +x and the azimuth is 180 deg - 360 deg * u; ours is 90 deg - 360 deg * u
+#: + rotation_z_deg (:func:`envmap_direction`): the two agree at +90 deg. Both put the top row at +z.
+BLENDER_ENVMAP_ROTATION_Z_DEG = 90.0
+
+
 def envmap_direction(u, v, rotation_z_deg: float = 0.0) -> np.ndarray:
     """World direction (..., 3) seen at position (u, v) of an equirectangular environment map
     (u in [0, 1] left to right along the columns, v in [0, 1] top to bottom along the rows; a
