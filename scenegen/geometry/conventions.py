@@ -221,6 +221,16 @@ def depth_z_from_range(range_m, rays_z1):
     return np.asarray(range_m) / np.linalg.norm(np.asarray(rays_z1), axis=-1)
 
 
+def opengl_from_directx_normal_map(normals01) -> np.ndarray:
+    """A tangent-space normal map stored DirectX-style (+y DOWN the image: Poly Haven's
+    ``nor_dx``, Unreal) in the OpenGL / glTF convention the renderer reads (+y UP the image for an
+    unmirrored texture, Mitsuba's ``normalmap``): values in [0, 1] (..., 3), the green channel
+    inverted, ``g -> 1 - g`` (n_y -> -n_y)."""
+    out = np.array(normals01, dtype=np.float32, copy=True)
+    out[..., 1] = 1.0 - out[..., 1]
+    return out
+
+
 #: The ``rotation_z_deg`` of an envmap light that shows an equirectangular image as Blender's world
 #: Environment Texture does (Poly Haven's HDRIs are made and previewed there). Cycles maps a
 #: direction d (Blender's world: Z-up, as ours) to u = 0.5 - atan2(d_y, d_x) / 2 pi, v = 1 -

@@ -10,6 +10,7 @@ import numpy as np
 
 from scenegen.assets.meshes import texture_image
 from scenegen.assets.texture_files import load_data_image
+from scenegen.geometry.conventions import opengl_from_directx_normal_map
 from scenegen.spec import model as m
 
 #: Board pictures are black/white; printed paper is neither 0 nor 1 in reflectance.
@@ -75,10 +76,27 @@ def _thin_dielectric(mat: m.ThinDielectricMaterial) -> dict:
 
 
 def _principled(mat: m.PrincipledMaterial) -> dict:
-    return {"type": "principled", "base_color": _reflectance(mat.color, mat.texture),
-            "metallic": float(mat.metallic), "roughness": float(mat.roughness),
-            "specular": float(mat.specular), "spec_trans": float(mat.spec_trans),
-            "clearcoat": float(mat.clearcoat), "sheen": float(mat.sheen)}
+    d = {"type": "principled", "base_color": _reflectance(mat.color, mat.texture),
+         "metallic": float(mat.metallic), "roughness": float(mat.roughness),
+         "specular": float(mat.specular), "spec_trans": float(mat.spec_trans),
+         "clearcoat": float(mat.clearcoat), "sheen": float(mat.sheen)}
+    pbr = getattr(mat, "pbr_set", None)
+    return d if pbr is None else with_pbr_set(d, pbr)
+
+
+def with_pbr_set(bsdf: dict, pbr) -> dict:
+    """A principled BSDF with a texture set's roughness and metallic maps (perceptual roughness,
+    as Blender's), wrapped in its bump (disp) and normal maps (a DirectX map converted to OpenGL's
+    +y up the image, :func:`scenegen.geometry.conventions.opengl_from_directx_normal_map`)."""
+    for key, mp in (("roughness", pbr.roughness), ("metallic", pbr.metallic)):
+        if mp is not None:
+            bsdf[key] = value_bitmap(load_data_image(mp.path)[..., mp.channel])
+    if pbr.disp is not None:
+        bsdf = with_bump_map(bsdf, load_data_image(pbr.disp.path)[..., 0], pbr.disp_scale_m)
+    if pbr.normal is not None:
+        normals = load_data_image(pbr.normal.path)
+        bsdf = with_normal_map(bsdf, opengl_from_directx_normal_map(normals) if pbr.normal.directx else normals)
+    return bsdf
 
 
 MATERIALS = {m.DiffuseMaterial: _diffuse, m.PlasticMaterial: _plastic, m.ConductorMaterial: _conductor,

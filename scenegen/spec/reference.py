@@ -34,6 +34,7 @@ RECORDS = (
     (m.ThinDielectricMaterial, "materials.NAME (type: thin_dielectric)", {}),
     (m.PrincipledMaterial, "materials.NAME (type: principled)", {}),
     (m.SurfaceMaps, "materials.NAME (any type): maps", {}),
+    (m.PbrSet, "materials.NAME.pbr_set (type: principled)", {}),
     (m.SceneObject, "objects[i]", {}),
     (m.Transform, "objects[i].transform", {}),
     (m.Animation, "objects[i]", {}),

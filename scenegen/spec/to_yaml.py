@@ -69,7 +69,10 @@ def _maps(mp: m.SurfaceMaps) -> dict:
 
 def _material(mat) -> dict:
     d: dict[str, Any] = {"type": mat.type}
-    if getattr(mat, "texture", None) is not None:
+    pbr = getattr(mat, "pbr_set", None)
+    if pbr is not None:  # the set gives the texture and the data maps
+        d["pbr_set"] = {"folder": pbr.folder, **write_fields(pbr)}
+    elif getattr(mat, "texture", None) is not None:
         d["texture"] = _texture(mat.texture)
     d.update(write_fields(mat))  # `color` is None (left out) when `texture` is given
     if mat.maps is not None:

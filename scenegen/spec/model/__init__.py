@@ -38,7 +38,7 @@ from scenegen.spec.model.lights import (
 from scenegen.spec.model.materials import (
     CONDUCTOR_NAMES, IMAGE_SUFFIXES, MATERIAL_TYPES, PROCEDURAL_TEXTURE_KINDS, TEXTURE_KINDS,
     ConductorMaterial, DielectricMaterial, DiffuseMaterial, Material, PlasticMaterial,
-    PrincipledMaterial, SurfaceMaps, Texture, ThinDielectricMaterial,
+    PbrMap, PbrSet, PrincipledMaterial, SurfaceMaps, Texture, ThinDielectricMaterial,
 )
 from scenegen.spec.model.meta import (
     ID_MAX, SEED_MAX, WORLD_UP, FieldInfo, Meta, field_info, frozen_mapping, spec_fields,
@@ -67,7 +67,7 @@ __all__ = [
     "PointLight", "SpotLight", "DirectionalLight",
     "CONDUCTOR_NAMES", "IMAGE_SUFFIXES", "MATERIAL_TYPES", "PROCEDURAL_TEXTURE_KINDS",
     "TEXTURE_KINDS", "ConductorMaterial", "DielectricMaterial", "DiffuseMaterial", "Material",
-    "PlasticMaterial", "PrincipledMaterial", "SurfaceMaps", "Texture", "ThinDielectricMaterial",
+    "PbrMap", "PbrSet", "PlasticMaterial", "PrincipledMaterial", "SurfaceMaps", "Texture", "ThinDielectricMaterial",
     "AssetFile",
     "ID_MAX", "SEED_MAX", "WORLD_UP", "FieldInfo", "Meta", "field_info", "frozen_mapping",
     "spec_fields",

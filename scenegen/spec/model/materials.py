@@ -62,6 +62,34 @@ _MAPS = dict(unit="normal map, bump map, alpha mask (None: none)", omit_default=
 
 
 @dataclass(frozen=True, kw_only=True)
+class PbrMap:
+    """One data map of a texture set: an image and the channel that holds the value."""
+
+    path: Path = part(unit="absolute path of the image (inside the set's folder)")
+    path_as_written: str = part(unit="the file's name in the set's folder")
+    channel: int = part(0, unit="channel index (0 R, 1 G, 2 B)")
+    directx: bool = part(False, unit="flag: a DirectX normal map (+y down the image), converted to "
+                                     "OpenGL's", omit_default=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class PbrSet:
+    """A PBR texture set folder in Poly Haven's naming (scenegen.assets.pbr_sets): its diff map is
+    the material's `texture`; roughness, metallic, normal and (with a scale) disp maps are here."""
+
+    folder: str = part(unit="the folder as written (relative to the spec file)")
+    name: str = param(unit="set name (the files' prefix)", derived="the folder's only set")
+    resolution: str = param(unit="resolution tag, e.g. '1k'", derived="the set's only resolution")
+    disp_scale_m: float | None = param(None, unit="metres of displacement per unit of the disp map",
+                                       lo=0.0, lo_open=True)  # None: the disp map is not read
+    roughness: PbrMap | None = part(None, unit="perceptual roughness map (rough, or arm's G)")
+    metallic: PbrMap | None = part(None, unit="metallic map (metal, or arm's B)")
+    normal: PbrMap | None = part(None, unit="tangent-space normal map (nor_gl, else nor_dx converted)")
+    disp: PbrMap | None = part(None, unit="height map read as the bump map (with disp_scale_m)")
+    where: Where | None = where_field()
+
+
+@dataclass(frozen=True, kw_only=True)
 class DiffuseMaterial:
     name: str | None = part(None, unit=_NAME)
     color: tuple[float, float, float] | None = param(_GREY, unit="linear RGB", lo=0.0, hi=1.0)
@@ -143,6 +171,8 @@ class PrincipledMaterial:
     clearcoat: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)
     sheen: float = param(0.0, unit="fraction", lo=0.0, hi=1.0)
     maps: SurfaceMaps | None = part(None, **_MAPS)
+    pbr_set: PbrSet | None = part(None, unit="a PBR texture set folder (Poly Haven naming) giving the "
+                                  "texture and the roughness, metallic and normal maps", omit_default=True)
     where: Where | None = where_field()
     type: str = field(default="principled", init=False)
 

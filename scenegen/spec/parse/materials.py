@@ -9,6 +9,7 @@ from scenegen.spec.model import materials as mm
 from scenegen.spec.model.meta import field_info, frozen_mapping, spec_fields
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.fields import read_fields, written_fields
+from scenegen.spec.parse.pbr_set import parse_pbr_set
 from scenegen.spec.parse.read import read_enum, seed_or_none
 
 
@@ -101,8 +102,12 @@ def parse_material(node: Node, name: str | None, ctx: ParseContext) -> mm.Materi
     if "type" not in f:
         f.check(required=("type",), optional=f.keys())
     kind = f.get("type").as_enum(mm.MATERIAL_TYPES, "material type")
-    f.check(required=("type",), optional=TYPE_KEYS[kind] + MAP_KEYS)
     cls = CLASSES[kind]
+    f.check(required=("type",), optional=TYPE_KEYS[kind] + MAP_KEYS + (("pbr_set",) if kind == "principled" else ()))
+    if "pbr_set" in f:  # a texture set folder gives the texture and the data maps
+        pbr, texture = parse_pbr_set(f.get("pbr_set"), f)
+        return cls(name=name, maps=parse_maps(f, node, ctx), where=node.where, color=None, texture=texture,
+                   pbr_set=pbr, **read_fields(f, cls, skip=("color",)))
     common = {"name": name, "maps": parse_maps(f, node, ctx), "where": node.where,
               **read_fields(f, cls, skip=("color", "material"))}
     if kind == "conductor":
