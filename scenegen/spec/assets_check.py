@@ -13,6 +13,7 @@ from scenegen.assets import meshes
 from scenegen.assets.envmap import check_envmap
 from scenegen.assets.libraries import mesh_within
 from scenegen.assets.mesh_materials import mesh_parts
+from scenegen.assets.texture_files import load_data_image
 from scenegen.errors import SpecError
 
 
@@ -38,6 +39,12 @@ def check_assets(spec) -> None:
         if texture is not None:
             with located(texture if getattr(texture, "where", None) else obj, f"object {obj.name!r} texture"):
                 meshes.texture_image(texture)
+        pbr = getattr(obj.material, "pbr_set", None)
+        if pbr is not None:  # a texture set's data maps, decoded as render decodes them
+            with located(pbr, f"object {obj.name!r} pbr_set"):
+                for mp in (pbr.roughness, pbr.metallic, pbr.normal, pbr.disp):
+                    if mp is not None:
+                        load_data_image(mp.path)
     for light in spec.lights:
         if light.type == "envmap":
             with located(light, f"light {light.name!r}"):

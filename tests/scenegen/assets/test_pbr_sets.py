@@ -80,6 +80,18 @@ def test_two_sets_or_an_exr_map_are_named(tmp_path):
         find_set(tmp_path / "x")
 
 
+def test_an_undecodable_map_fails_validate_at_the_sets_line(tmp_path, capsys):
+    write_set(tmp_path / "t")
+    (tmp_path / "t/brick_wall_001_rough_1k.jpg").write_bytes(b"not a jpeg")
+    spec = {"name": "s", "materials": {"m": {"type": "principled", "pbr_set": {"folder": "t"}}},
+            "objects": [{"name": "floor", "shape": "plane", "material": "m"}]}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(spec))
+    capsys.readouterr()
+    assert main(["validate", str(tmp_path / "s.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 's.yaml'}:" in err and "pbr_set" in err and "rough_1k.jpg" in err and "Traceback" not in err, err
+
+
 def test_the_resolved_spec_records_the_set_and_round_trips(tmp_path):
     write_set(tmp_path / "t")
     text = yaml.safe_dump({"name": "s", "materials": {"m": {"type": "principled", "roughness": 0.3,
