@@ -133,9 +133,10 @@ def category_ids(layout_name: str, root: Path, category: str) -> tuple[str, ...]
     return tuple(ids)
 
 
-def pick_id(layout_name: str, root: Path, category: str, pick: int, seed: int) -> str:
-    """Model ``pick`` of a seeded permutation of the category's sorted ids: picks 0 .. N-1 with
-    one seed are N distinct models."""
+def pick_id(layout_name: str, root: Path, category: str, pick: int | None, seed: int) -> str:
+    """Model ``pick`` (None: the first, 0) of a seeded permutation of the category's sorted ids:
+    picks 0 .. N-1 with one seed are N distinct models."""
+    pick = 0 if pick is None else pick
     ids = category_ids(layout_name, root, category)
     if not 0 <= pick < len(ids):
         raise LibraryError(f"pick {pick}: category {category!r} holds {len(ids)} models "

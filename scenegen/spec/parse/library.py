@@ -38,7 +38,7 @@ def library_model(f: Fields, node: Node, ctx: ParseContext):
             model_id = f.get("id").as_str("a model id")
         else:
             category = f.get("category").as_str("a category (a ShapeNet synset id)")
-            pick = f.get("pick").as_int("a pick index", lo=0) if "pick" in f else 0
+            pick = f.get("pick").as_int("a pick index", lo=0) if "pick" in f else None
             seed = (f.get("seed").as_int("a seed", lo=0, hi=2**32 - 1) if "seed" in f
                     else ctx.seed_for(f"library.{layout}.{category}"))  # shared: picks 0..N-1 differ
             model_id = pick_id(layout, root, category, pick, seed)

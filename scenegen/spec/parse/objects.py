@@ -16,6 +16,7 @@ from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.library import library_model
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.optics import parse_motion
+from scenegen.spec.model.meta import field_info
 from scenegen.spec.parse.read import read_float, read_int, seed_or_none
 from scenegen.spec.parse.timeline import ANIMATION_KEYS, parse_animation
 from scenegen.spec.parse.transforms import parse_transform
@@ -55,11 +56,10 @@ def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
     checked: inside the mesh's folder -- a library model's folder --, existing; an error names
     the asset file and line) and whether its own materials are rendered: yes when the file has
     materials and the object gives none; a `material:` replaces them, with a warning."""
-    up_node = scale_node = library = None
-    within = None
+    up_node = library = within = node_f = None
     if node.is_mapping:  # `mesh: {path: ..., up_axis: y}` or `mesh: {library: ..., root: ..., id: ...}`
-        f = node.as_mapping("a mesh (a file path, or a mapping with 'path' or 'library')")
-        up_node, scale_node = f.get("up_axis"), f.get("scale")
+        f = node_f = node.as_mapping("a mesh (a file path, or a mapping with 'path' or 'library')")
+        up_node = f.get("up_axis")
         if "library" in f:
             lib, library, written, up_default = library_model(f, node, ctx)
             path, within = lib.path, lib.asset_dir
@@ -70,7 +70,7 @@ def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:
         path, written = node.as_path(mg.MESH_SUFFIXES, "mesh")
         up_default = mesh_up_axis(path.suffix)
     up_axis = up_default if up_node is None else up_node.as_enum(mg.MESH_UP_AXES, "up axis")
-    scale = 1.0 if scale_node is None else scale_node.as_float("metres per file unit", lo=0.0, lo_open=True)
+    scale = read_float(node_f, mg.Mesh, "scale") if node_f is not None else field_info(mg.Mesh, "scale").default
     try:
         scan = scan_mesh_file(path, within)
     except AssetFileError as e:

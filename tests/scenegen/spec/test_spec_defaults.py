@@ -102,6 +102,8 @@ CASES = [
      "objects:\n  - name: o\n    target: {type: charuco, squares_x: 5, squares_y: 4, "
      "square_m: 0.04, marker_m: 0.032, dictionary: DICT_4X4_50}\n",
      lambda s: s.objects[0].geometry.legacy_pattern, True),
+    (m.Mesh, "scale", "objects:\n  - {name: o, mesh: {path: mesh.stl}}\n",
+     lambda s: s.objects[0].geometry.scale, 0.01),
     (m.Transform, "scale", "objects:\n  - {name: o, shape: sphere, transform: {}}\n",
      lambda s: s.objects[0].transform.scale, (2.0, 2.0, 2.0)),
     (m.AreaLight, "size", "lights:\n  - {type: area, position: [0, 0, 2], look_at: [0, 0, 0], "
@@ -180,6 +182,7 @@ IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 def parse(text, tmp_path):
     (tmp_path / "env.png").write_bytes(b"not read at parse time")
+    (tmp_path / "mesh.stl").write_bytes(b"solid not read at parse time")
     return parse_spec(text, file="scene.yaml", base_dir=tmp_path)
 
 
