@@ -26,6 +26,7 @@ from typing import Iterable, Mapping, get_args
 
 from scenegen.assets.asset_refs import AssetFileError, scan_mesh_file
 from scenegen.assets.libraries import LAYOUTS, LibraryError, check_id, library_file, mesh_within, pick_id
+from scenegen.assets.pbr_sets import PbrSetError, find_set
 from scenegen.errors import SpecError
 from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.geometry.pose import Rigid3, look_at
@@ -41,11 +42,12 @@ from scenegen.spec.model import (  # re-exported: the building blocks
 )
 from scenegen.spec.model.geometry import AssetFile, LibraryRef, Mesh
 from scenegen.spec.model.lights import Light
-from scenegen.spec.model.materials import Material, PrincipledMaterial
+from scenegen.spec.model.materials import Material, PbrSet, PrincipledMaterial
 from scenegen.spec.model.meta import frozen_mapping
 from scenegen.spec.model.timeline import Animation, JointSpec, Keyframe, SequenceSpec, TrackSpec, TrajectorySpec
 from scenegen.spec.model.views import TrajectoryPath
 from scenegen.spec.parse.lights import default_light_name
+from scenegen.spec.parse.pbr_set import pbr_records
 from scenegen.spec.parse.rigs import stereo_rig
 from scenegen.spec.parse.timeline import start_transform
 from scenegen.spec.source import SpecSource
@@ -53,7 +55,7 @@ from scenegen.spec.to_yaml import PYTHON_FILE
 
 __all__ = [
     "Scene", "camera", "obj", "render", "to_yaml", "check_spec", "same_spec", "SpecError",
-    "mesh", "library_mesh", "library_picks", "image_texture", "sequence", "keyframe", "trajectory", "stereo_rig",
+    "mesh", "library_mesh", "library_picks", "pbr_set_material", "image_texture", "sequence", "keyframe", "trajectory", "stereo_rig",
     "Animation", "JointSpec", "Keyframe", "Mesh", "PrincipledMaterial", "SequenceSpec", "TrackSpec",
     "TrajectoryPath", "TrajectorySpec",
     "AreaLight", "ArucoGridTarget", "Blob", "Box", "CameraSpec", "CharucoTarget", "CheckerboardTarget",
@@ -99,6 +101,27 @@ def library_picks(library: str, root, category: str, count: int, seed: int = 0) 
         return tuple(pick_id(library, Path(root), category, k, seed) for k in range(int(count)))
     except LibraryError as e:
         raise SpecError(str(e), file=PYTHON_FILE, field=f"library_picks.{e.key}") from None
+
+
+def pbr_set_material(folder, *, name: str | None = None, resolution: str | None = None,
+                     disp_scale_m: float | None = None, **principled) -> PrincipledMaterial:
+    """A principled material whose texture and roughness, metallic and normal maps come from a
+    PBR texture set folder in Poly Haven's naming, as the YAML's ``pbr_set:`` (docs/scene_spec.md
+    "PBR texture sets"); a relative ``folder`` resolves against ``Scene(base_dir=...)``;
+    ``principled``: the other PrincipledMaterial fields (specular, ...)."""
+    return PrincipledMaterial(color=None, pbr_set=PbrSet(folder=str(folder), name=name, resolution=resolution,
+                                                         disp_scale_m=disp_scale_m), **principled)
+
+
+def _resolved_pbr_set(mat: PrincipledMaterial, base: Path, field: str) -> PrincipledMaterial:
+    """A pbr_set_material with its set found in its folder (as the parser finds it)."""
+    p = mat.pbr_set
+    try:
+        found = find_set((base / Path(p.folder).expanduser()).resolve(), p.name, p.resolution)
+        pbr, texture = pbr_records(found, p.folder, p.disp_scale_m)
+    except PbrSetError as e:
+        raise SpecError(str(e), file=PYTHON_FILE, field=f"{field}.pbr_set.{e.key}") from None
+    return dataclasses.replace(mat, pbr_set=pbr, texture=texture, color=None)
 
 
 def image_texture(path) -> Texture:
@@ -233,9 +256,11 @@ def _resolved_paths(x, base: Path, field: str):
         return type(x)(_resolved_paths(v, base, f"{field}[{i}]") for i, v in enumerate(x))
     if not dataclasses.is_dataclass(x) or isinstance(x, type):
         return x
+    if isinstance(x, PrincipledMaterial) and x.pbr_set is not None and x.texture is None:
+        x = _resolved_pbr_set(x, base, field)
     changes = {}
     for f in dataclasses.fields(x):
-        if not f.init or f.name == "where":
+        if not f.init or f.name in ("where", "pbr_set"):  # a set is found by _resolved_pbr_set
             continue
         v = getattr(x, f.name)
         if f.name == "path" and v is not None and hasattr(x, "path_as_written"):

@@ -14,7 +14,7 @@ from scenegen.spec.parse.fields import check_keys, read_fields
 SET_GIVES = ("color", "texture", "normal_map", "bump_map")
 
 
-def _pbr_map(m: SetMap | None, folder: Path) -> mm.PbrMap | None:
+def _pbr_map(m: SetMap | None) -> mm.PbrMap | None:
     if m is None:
         return None
     return mm.PbrMap(path=m.path, path_as_written=m.path.name, channel=m.channel, directx=m.directx)
@@ -39,14 +39,22 @@ def parse_pbr_set(node: Node, material: "Fields") -> tuple[mm.PbrSet, mm.Texture
         found = find_set(folder, values["name"], values["resolution"])
     except PbrSetError as e:
         raise (f.get(e.key) or f.get("folder")).error(str(e)) from None
+    try:
+        return pbr_records(found, text, values["disp_scale_m"], node.where)
+    except PbrSetError as e:
+        raise f.get("disp_scale_m").error(str(e)) from None
+
+
+def pbr_records(found, folder_text: str, disp_scale_m: float | None, where=None) -> tuple[mm.PbrSet, mm.Texture]:
+    """(the PbrSet record, the diff map as a texture) of a found set (also the Python API's)."""
     disp = None
-    if values["disp_scale_m"] is not None:
+    if disp_scale_m is not None:
         if found.disp is None:
-            raise f.get("disp_scale_m").error(f"set {found.name!r} ({found.resolution}) has no disp map")
+            raise PbrSetError(f"set {found.name!r} ({found.resolution}) has no disp map", "disp_scale_m")
         disp = mm.PbrMap(path=found.disp, path_as_written=found.disp.name)
-    pbr = mm.PbrSet(folder=text, name=found.name, resolution=found.resolution, disp_scale_m=values["disp_scale_m"],
-                    roughness=_pbr_map(found.roughness, folder), metallic=_pbr_map(found.metallic, folder),
-                    normal=_pbr_map(found.normal, folder), disp=disp, where=node.where)
-    texture = mm.Texture(kind="image", path=found.base_color, path_as_written=f"{text.rstrip('/')}/{found.base_color.name}",
-                         where=node.where)
+    pbr = mm.PbrSet(folder=folder_text, name=found.name, resolution=found.resolution, disp_scale_m=disp_scale_m,
+                    roughness=_pbr_map(found.roughness), metallic=_pbr_map(found.metallic),
+                    normal=_pbr_map(found.normal), disp=disp, where=where)
+    texture = mm.Texture(kind="image", path=found.base_color,
+                         path_as_written=f"{folder_text.rstrip('/')}/{found.base_color.name}", where=where)
     return pbr, texture

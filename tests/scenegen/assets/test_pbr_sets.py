@@ -138,3 +138,19 @@ def test_a_set_renders_its_colour_and_its_normal_map_in_opengl_convention(tmp_pa
     # world -y), so n_y > 0 (OpenGL: up the image) tilts toward the light at +y: cos 15 deg
     # against cos 75 deg, 3.7x (measured 4.2 with Mitsuba's bump-terminator shadowing)
     assert got["up"] > 3.0 * got["gl"], got
+
+
+def test_the_python_api_builds_the_same_material_as_the_yaml(tmp_path):
+    from scenegen import api
+    from scenegen.errors import SpecError
+    from scenegen.spec import spec_to_dict
+    write_set(tmp_path / "t", maps=("diff", "arm", "nor_dx", "disp"))
+    spec = api.Scene("s", base_dir=tmp_path, materials={"m": api.pbr_set_material("t", disp_scale_m=0.002, specular=0.3)},
+                     objects=[api.obj("floor", api.Plane(), material="m")])
+    text = yaml.safe_dump({"name": "s", "materials": {"m": {"type": "principled", "specular": 0.3,
+                                                              "pbr_set": {"folder": "t", "disp_scale_m": 0.002}}},
+                           "objects": [{"name": "floor", "shape": "plane", "material": "m"}]})
+    parsed = parse_spec(text, file="s.yaml", base_dir=tmp_path)
+    assert spec_to_dict(spec)["materials"] == spec_to_dict(parsed)["materials"]
+    with pytest.raises(SpecError, match=r"materials.m.pbr_set.name: no set 'x'"):
+        api.Scene("s", base_dir=tmp_path, materials={"m": api.pbr_set_material("t", name="x")})
