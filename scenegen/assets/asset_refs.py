@@ -59,17 +59,31 @@ class AssetScan:
         return bool(self.materials) or self.vertex_colors
 
 
+@dataclass(frozen=True)
+class AssetScope:
+    """Where the files a mesh names may lie: inside ``root``; a name not found where it is
+    relative to is also looked up in the ``search`` folders (Google Scanned Objects' MTL names
+    ``texture.png``, which lies in ``materials/textures/``)."""
+
+    root: Path
+    search: tuple[Path, ...] = ()
+
+
 def checked_ref(written: str, asset_dir: Path, source: Path, line: int | None, key: str,
-                within: Path | None = None) -> AssetRef:
+                within: "Path | AssetScope | None" = None) -> AssetRef:
     """A file name read from ``source``, relative to ``asset_dir``, checked to lie inside
-    ``within`` (default ``asset_dir``; a library model's folder, :mod:`scenegen.assets.libraries`)."""
+    ``within`` (default ``asset_dir``; a library model's folder or scope,
+    :mod:`scenegen.assets.libraries`)."""
     where = lambda msg: AssetFileError(f"{key} {written!r}: {msg}", source, line)
     if not written.strip():
         raise where("expected a file name, got nothing")
     if _URI_SCHEME.match(written) or written.startswith(("/", "\\")) or Path(written).is_absolute():
         raise where("expected a path relative to the asset's folder (no absolute path or URL)")
-    root = (asset_dir if within is None else within).resolve()
+    scope = within if isinstance(within, AssetScope) else AssetScope(asset_dir if within is None else within)
+    root = scope.root.resolve()
     full = (asset_dir.resolve() / written).resolve()
+    if not full.is_file():
+        full = next((c for c in ((d / written).resolve() for d in scope.search) if c.is_file()), full)
     if full != root and root not in full.parents:
         raise where(f"leaves the asset's folder {str(root)!r}; asset files may only name files "
                     "inside it")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from scenegen.assets.asset_refs import AssetFileError, checked_ref
+from scenegen.assets.asset_refs import AssetFileError, AssetScope, checked_ref
 
 #: One part of an id: letters, digits and ``_ - . +`` (not starting with a dot).
 _ID_PART = re.compile(r"^[A-Za-z0-9_+-][A-Za-z0-9_.+-]*$")
@@ -45,6 +45,7 @@ class Layout:
     units: str  # the files' length unit (documentation)
     asset_up: int  # the asset folder (files the mesh may name): the mesh path's parents[asset_up]
     source: str  # where the conventions are stated
+    search: tuple[str, ...] = ()  # folders of the asset folder where names not found are looked up
 
 
 LAYOUTS = {
@@ -58,7 +59,8 @@ LAYOUTS = {
         "ShapeNetCore v1 README: 'up direction is the +Y axis, and the front is the +X axis'"),
     "gso": Layout(
         "gso", "{id}/meshes/model.obj", 1, "z", "none (scans)", "metres", 1,
-        "Google Scanned Objects: Z-up, metres (meshes/model.obj, materials/textures/texture.png)"),
+        "Google Scanned Objects: Z-up, metres (meshes/model.obj, materials/textures/texture.png)",
+        ("materials/textures",)),  # its model.mtl names 'texture.png', kept in materials/textures/
     "objaverse": Layout(
         "objaverse", "{id}.glb", 1, "y", "+z (glTF)", "as authored (glTF says metres)", 0,
         "glTF 2.0 'Coordinate System and Units': +Y up, +Z front, metres"),
@@ -86,7 +88,7 @@ def check_id(layout: Layout, model_id: str) -> None:
 class LibraryFile:
     path: Path  # absolute, resolved, inside the root
     relative: str  # the mesh file relative to the root (posix)
-    asset_dir: Path  # the folder the mesh's own files (MTL, textures) must lie in
+    asset_dir: AssetScope  # where the mesh's own files (MTL, textures) must lie and are looked up
 
 
 def library_file(layout_name: str, root: Path, model_id: str) -> LibraryFile:
@@ -106,12 +108,14 @@ def library_file(layout_name: str, root: Path, model_id: str) -> LibraryFile:
     return LibraryFile(ref.path, relative, asset_dir_of(ref.path, layout_name))
 
 
-def asset_dir_of(mesh_path: Path, layout_name: str | None) -> Path:
-    """The folder the files named inside a mesh may lie in: the mesh's own folder, or a library
-    model's folder (ShapeNet v2 names ``../images/...`` from ``models/``)."""
+def asset_dir_of(mesh_path: Path, layout_name: str | None) -> AssetScope:
+    """Where the files named inside a mesh may lie: the mesh's own folder, or a library model's
+    folder (ShapeNet v2 names ``../images/...`` from ``models/``) with its layout's search folders."""
     if layout_name is None:
-        return Path(mesh_path).parent
-    return Path(mesh_path).parents[LAYOUTS[layout_name].asset_up]
+        return AssetScope(Path(mesh_path).parent)
+    layout = LAYOUTS[layout_name]
+    root = Path(mesh_path).parents[layout.asset_up]
+    return AssetScope(root, tuple(root / d for d in layout.search))
 
 
 def category_ids(layout_name: str, root: Path, category: str) -> tuple[str, ...]:
@@ -145,7 +149,7 @@ def pick_id(layout_name: str, root: Path, category: str, pick: int | None, seed:
     return ids[int(order[pick])]
 
 
-def mesh_within(geometry) -> Path:
+def mesh_within(geometry) -> AssetScope:
     """The folder the files named inside a spec mesh may lie in (read by attribute: ``path`` and
     ``library``, so no spec import)."""
     library = getattr(geometry, "library", None)

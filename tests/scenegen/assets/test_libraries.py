@@ -56,10 +56,11 @@ def write_shapenet(root: Path, model: str = CAR, synset: str = SYNSET, srgb=SHAP
 
 
 def write_gso(root: Path, name: str = GSO_NAME) -> Path:
-    """Google Scanned Objects: <name>/meshes/model.{obj,mtl}, materials/textures/texture.png."""
+    """Google Scanned Objects as shipped: <name>/meshes/model.{obj,mtl}, the MTL naming
+    'texture.png', which lies in materials/textures/ (not next to the MTL)."""
     m = root / name
     _obj(m / "meshes/model.obj", GSO_QUAD, "model.mtl")
-    (m / "meshes/model.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd ../materials/textures/texture.png\n")
+    (m / "meshes/model.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd texture.png\n")
     _png(m / "materials/textures/texture.png", GSO_SRGB)
     return m
 
