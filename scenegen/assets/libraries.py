@@ -143,7 +143,7 @@ def pick_id(layout_name: str, root: Path, category: str, pick: int | None, seed:
     pick = 0 if pick is None else pick
     ids = category_ids(layout_name, root, category)
     if not 0 <= pick < len(ids):
-        raise LibraryError(f"pick {pick}: category {category!r} holds {len(ids)} models "
+        raise LibraryError(f"pick {pick}: category {category!r} holds {len(ids)} model{'s' * (len(ids) != 1)} "
                            f"(expected 0 <= pick < {len(ids)})", "pick")
     order = np.random.default_rng(seed).permutation(len(ids))
     return ids[int(order[pick])]

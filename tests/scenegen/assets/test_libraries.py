@@ -55,6 +55,15 @@ def write_shapenet(root: Path, model: str = CAR, synset: str = SYNSET, srgb=SHAP
     return m
 
 
+def write_shapenet_v1(root: Path, model: str = CAR, synset: str = SYNSET) -> Path:
+    """ShapeNetCore v1: <synset>/<model>/model.{obj,mtl}, the texture beside them."""
+    m = root / synset / model
+    _obj(m / "model.obj", SHAPENET_QUAD, "model.mtl")
+    (m / "model.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd texture0.png\n")
+    _png(m / "texture0.png", SHAPENET_SRGB)
+    return m
+
+
 def write_gso(root: Path, name: str = GSO_NAME) -> Path:
     """Google Scanned Objects as shipped: <name>/meshes/model.{obj,mtl}, the MTL naming
     'texture.png', which lies in materials/textures/ (not next to the MTL)."""
@@ -78,6 +87,7 @@ def write_objaverse(root: Path, uid: str = UID) -> Path:
 
 def libraries(tmp_path: Path) -> Path:
     write_shapenet(tmp_path / "ShapeNetCore.v2")
+    write_shapenet_v1(tmp_path / "ShapeNetCore.v1")
     write_gso(tmp_path / "gso")
     write_objaverse(tmp_path / "objaverse")
     return tmp_path
@@ -97,6 +107,7 @@ def _parse(tmp_path, mesh):
 @pytest.mark.parametrize("layout, root, model_id, rot, scale, bounds", [
     # ShapeNet: file y (up) -> z, file -z (its front) -> +y; x2: z = 0.5, y in [-0.2, 0.4]
     ("shapenet", "ShapeNetCore.v2", f"{SYNSET}/{CAR}", ROT_X90, 2.0, [[-0.6, -0.2, 0.5], [0.6, 0.4, 0.5]]),
+    ("shapenet_v1", "ShapeNetCore.v1", f"{SYNSET}/{CAR}", ROT_X90, 1.0, [[-0.3, -0.1, 0.25], [0.3, 0.2, 0.25]]),
     ("gso", "gso", GSO_NAME, np.eye(3), 1.0, [[-0.2, -0.1, 0.1], [0.2, 0.3, 0.1]]),  # Z-up metres: as stored
     ("objaverse", "objaverse", UID, ROT_X90, 0.5, [[0.0, -0.25, 0.0], [0.25, 0.0, 0.0]]),  # glTF floor -> z = 0
 ])
@@ -134,7 +145,7 @@ def _validate(tmp_path, mesh, capsys) -> tuple[int, str]:
     ({"library": "gso", "root": "nowhere", "id": GSO_NAME}, "no such folder"),
     ({"library": "gso", "root": "gso", "id": "escape"}, "leaves the library root"),
     ({"library": "shapenet", "root": "ShapeNetCore.v2", "category": "..", "pick": 0}, "plain names"),
-    ({"library": "shapenet", "root": "ShapeNetCore.v2", "category": SYNSET, "pick": 5}, "holds 1 models"),
+    ({"library": "shapenet", "root": "ShapeNetCore.v2", "category": SYNSET, "pick": 5}, "holds 1 model "),
     ({"library": "gso", "root": "gso", "category": "x"}, "has no categories"),
     ({"library": "shapenet", "root": "ShapeNetCore.v2", "id": f"{SYNSET}/{CAR}", "pick": 1}, "goes with 'category'"),
     ({"library": "blender", "root": "gso", "id": GSO_NAME}, "library layout"),
