@@ -30,6 +30,7 @@ from scenegen.dataset.files import remove_stale_temp_files
 from scenegen.dataset.view_files import write_view_files
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import configure_llvm, load_scene
+from scenegen.render.threads import render_threads, set_render_threads
 from scenegen.spec import resolve_views
 
 __all__ = ["open_client", "render_views_dask", "render_frame_task", "worker_scene", "worker_stats", "note_stage_items",
@@ -56,9 +57,8 @@ def open_client(*, workers: int | None = None, scheduler: str | None = None):
     if (workers is None) == (scheduler is None):
         raise ValueError("give exactly one of --workers N and --scheduler ADDRESS")
     try:
-        # Dask on use: a heavy dependency (~1 s to import) that only --workers/--scheduler need
-        import dask
-        from distributed import Client, LocalCluster
+        import dask  # Dask on use: a heavy dependency (~1 s to import) that only --workers/--scheduler need
+        from distributed import Client, LocalCluster  # its client and local cluster: the same reason
     except ImportError:  # fail only when the feature is used
         raise ValueError("--workers/--scheduler need Dask distributed: pip install 'dask[distributed]'") from None
     if scheduler is not None:
@@ -98,8 +98,7 @@ def worker_scene(source, spp: int, variant: str):
     built = load_scene(spec, variant=variant, spp=spp)  # libLLVM path, then Mitsuba, the variant
     threads = os.environ.get(DRJIT_THREADS_ENV)
     if threads:  # a local cluster's worker: its share of the cores
-        import drjit as dr  # after load_scene: Mitsuba's import pointed Dr.Jit at its libLLVM
-        dr.set_thread_count(int(threads))
+        set_render_threads(int(threads))
     _SCENES[key] = (spec, resolve_views(spec), built)
     _STATS["scene_loads"] += 1
     while len(_SCENES) > SCENES_KEPT:
@@ -130,9 +129,9 @@ def note_stage_items(n: int) -> None:
 
 
 def worker_stats() -> dict:
-    """This process's counters: scene_loads, views_rendered, stage_items, pid (run it with
-    ``client.run``)."""
-    return {**_STATS, "pid": os.getpid()}
+    """This process's counters: scene_loads, views_rendered, stage_items, pid, render_threads
+    (Dr.Jit's; None before a scene is loaded) (run it with ``client.run``)."""
+    return {**_STATS, "pid": os.getpid(), "render_threads": render_threads()}
 
 
 def render_views_dask(client, source, writer, pending, *, spp: int, seed: int, variant: str,
