@@ -12,7 +12,7 @@ worker killed mid-write leaves a temporary file; the client removes those once e
 
 Workers must see the output folder at the same path (one machine, or a shared file system).
 A local cluster shares this machine's cores: each worker's Dr.Jit pool gets cores / workers
-threads (two processes with a pool of all cores each spent 20-30 % more CPU on the same work,
+threads (two processes with a pool of all cores each spent about 20 % more CPU on the same work,
 docs/performance.md), and Dask's own periodic work (event-loop ticks, monitors, the workers' stack
 sampler) is made rarer (:data:`LOCAL_CLUSTER_CONFIG`).
 Mitsuba is imported in a worker only through :func:`scenegen.render.load_scene`, which points
