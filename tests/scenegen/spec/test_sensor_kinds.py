@@ -11,6 +11,7 @@ import pytest
 
 from scenegen.errors import SpecError
 from scenegen.spec import parse_spec, resolve_views, same_spec, spec_sha256, spec_to_dict, to_yaml
+from scenegen.spec.parse.scene import TOP_LEVEL_KEYS
 from scenegen.spec.sensors import SENSOR_KINDS, STREAM, VIEWS, SensorKind, SensorRun
 from scenegen.spec.views import rig_frames
 
@@ -159,3 +160,10 @@ def test_a_kind_declares_a_writer_exactly_when_it_writes_a_stream():
     with pytest.raises(ValueError, match="produces must be one of"):
         SensorKind(name="thing", produces="images", **common)
     assert SENSOR_KINDS["camera"].produces == VIEWS and "depth_z" in SENSOR_KINDS["camera"].truth
+
+
+def test_every_kind_has_a_section_of_its_own(clock):
+    sections = [k.section for k in SENSOR_KINDS.values()]
+    assert len(set(sections)) == len(sections)
+    assert [k.section for k in SENSOR_KINDS.values() if k.spec_field is None] == ["clocks"]
+    assert all(k.section not in TOP_LEVEL_KEYS for k in SENSOR_KINDS.values() if k.spec_field is None)
