@@ -5,7 +5,7 @@ views (a stream covers all frames of its view set, whatever ``--frames`` selects
 does)."""
 from __future__ import annotations
 
-from scenegen.spec.sensors import SENSOR_KINDS, STREAM, SensorRun
+from scenegen.spec.sensors import SENSOR_KINDS, STREAM, SensorRun, stream_name
 from scenegen.spec.views import rig_frames
 
 
@@ -18,7 +18,7 @@ def stream_runs(spec, writer, scene) -> tuple[SensorRun, ...]:
             kind = SENSOR_KINDS[member.kind]
             if kind.produces == STREAM:
                 runs.append(SensorRun(spec=spec, member=member, sensor=kind.sensors_of(spec)[member.sensor],
-                                      frames=frames, stream=f"{vs.prefix}_{member.name}", writer=writer,
+                                      frames=frames, stream=stream_name(vs, member), writer=writer,
                                       scene=scene))
     return tuple(runs)
 

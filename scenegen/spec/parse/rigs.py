@@ -7,8 +7,8 @@ import math
 from scenegen.geometry.pose import Rigid3
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model.cameras import RIG_TYPES, Rig, RigMember
-from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.model.meta import field_info
+from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.parse.transforms import parse_pose

@@ -6,12 +6,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
+from scenegen.dataset.layout import check_name
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Fields, Node
 from scenegen.spec.finite import check_finite
 from scenegen.spec.model.limits import MAX_VIEWS
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.model.scene import SceneSpec
+from scenegen.spec.model.views import TrajectoryPath
 from scenegen.spec.parse.cameras import parse_camera
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.crossview import check_pair_views, parse_crossview
@@ -25,9 +27,7 @@ from scenegen.spec.parse.timeline import check_sequence, parse_sequence
 from scenegen.spec.parse.truth import parse_truth
 from scenegen.spec.parse.variation import parse_variation
 from scenegen.spec.parse.views import parse_view_set
-from scenegen.dataset.layout import check_name
-from scenegen.spec.model.views import TrajectoryPath
-from scenegen.spec.sensors import SENSOR_KINDS, STREAM, section_kinds
+from scenegen.spec.sensors import SENSOR_KINDS, STREAM, section_kinds, stream_name
 from scenegen.spec.views import resolve_views, view_members
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
@@ -146,7 +146,7 @@ def check_stream_members(node, view_sets, rigs) -> None:
             if not isinstance(vs.placement, TrajectoryPath):
                 raise item.error(f"rig {vs.rig!r} holds the {mb.kind} {mb.name!r}, whose stream samples over "
                                  "time: its view set needs times (a `trajectory:` placement)")
-            name = f"{vs.prefix}_{mb.name}"
+            name = stream_name(vs, mb)
             try:
                 check_name("stream", name)
             except ValueError as e:

@@ -23,6 +23,12 @@ PRODUCTS = (VIEWS, STREAM)
 MEMBER_KEYS = ("sensor", "rig_from_sensor")
 
 
+def stream_name(view_set, member) -> str:
+    """The stream a rig member of a stream kind writes for a view set: ``<view set>_<member>``
+    (the view set's ``prefix``: its name, else its rig's)."""
+    return f"{view_set.prefix}_{member.name}"
+
+
 @dataclass(frozen=True, kw_only=True)
 class RigFrame:
     """A rig at a time: one placement of a rig view set. ``time_s`` is seconds on the sequence

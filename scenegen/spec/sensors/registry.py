@@ -3,7 +3,6 @@ kind"). The spec reads each kind's section and rig members through it, and the p
 each member's output through it."""
 from __future__ import annotations
 
-from scenegen.errors import SpecError
 from scenegen.spec.sensors.camera import CAMERA
 from scenegen.spec.sensors.kind import SensorKind
 
@@ -11,14 +10,6 @@ from scenegen.spec.sensors.kind import SensorKind
 SENSOR_KINDS: dict[str, SensorKind] = {
     CAMERA.name: CAMERA,
 }
-
-
-def sensor_kind(name: str, where=None) -> SensorKind:
-    """The registered kind ``name``; a SpecError at ``where`` naming the kinds otherwise."""
-    kind = SENSOR_KINDS.get(name)
-    if kind is None:
-        raise SpecError.at(where, f"unknown sensor kind {name!r}; expected one of {sorted(SENSOR_KINDS)}")
-    return kind
 
 
 def section_kinds() -> tuple[SensorKind, ...]:
