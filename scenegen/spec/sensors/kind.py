@@ -69,7 +69,7 @@ class SensorKind:
 
     ``section``: the top-level YAML key of its sensors (a mapping name -> sensor) and ``parse``
     ``(node, name, ctx) -> model`` one of them (a :class:`scenegen.spec.parse.context
-    .ParseContext` knows the cameras and the other sensors parsed before); ``model`` the frozen
+    .ParseContext` that knows the render settings, materials and cameras); ``model`` the frozen
     dataclass it returns. ``spec_field``: the :class:`SceneSpec` attribute holding the section
     (``cameras`` for cameras), None = ``SceneSpec.sensors[name]``. ``member_keys``: the keys a rig
     member names its sensor and its pose with, besides ``sensor`` / ``rig_from_sensor`` (the
