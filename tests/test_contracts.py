@@ -112,8 +112,10 @@ SCENEGEN_LAYERS = {
     "scenegen.assets": ("scenegen.geometry", "scenegen.quiet"),
     "scenegen.imaging": ("scenegen.geometry", "scenegen.dataset"),
     "scenegen.crossview": ("scenegen.geometry", "scenegen.dataset"),
+    # a sensor kind (scenegen.spec.sensors) names what it writes in the dataset's terms (truth keys,
+    # a stream's schema and StreamWriter)
     "scenegen.spec": ("scenegen.errors", "scenegen.located_yaml", "scenegen.geometry", "scenegen.assets",
-                      "scenegen.imaging"),
+                      "scenegen.imaging", "scenegen.dataset"),
     # the renderer implements the dataset's visibility rule (dataset.crossview.OCCLUSION_REL_TOL)
     # and casts the truth kinds the dataset stores (dataset.truth.TruthKind)
     "scenegen.render": ("scenegen.errors", "scenegen.geometry", "scenegen.assets", "scenegen.spec",

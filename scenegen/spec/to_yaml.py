@@ -25,6 +25,7 @@ from scenegen.spec.load import parse_spec
 from scenegen.spec.parse.fields import plain_value, write_fields
 from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.optics import OPTICS_KEYS
+from scenegen.spec.sensors import SENSOR_KINDS, section_kinds
 from scenegen.spec.serialize import spec_to_dict
 
 
@@ -182,9 +183,13 @@ def _rig(r: m.Rig) -> dict:
         left, right = r.members
         return {"type": "stereo", "left": left.camera, "right": right.camera, "baseline_m": r.baseline_m,
                 "vergence_deg": r.vergence_deg}
-    return {"type": "multi", "members": [{"camera": mb.camera, "name": mb.name,
-                                          "rig_from_cam": [[float(v) for v in row] for row in mb.rig_from_cam.matrix]}
-                                         for mb in r.members]}
+    return {"type": "multi", "members": [_member(mb) for mb in r.members]}
+
+
+def _member(mb: m.RigMember) -> dict:
+    sensor_key, pose_key = SENSOR_KINDS[mb.kind].member_keys  # a camera's: camera, rig_from_cam
+    return {"kind": mb.kind, sensor_key: mb.sensor, "name": mb.name,
+            pose_key: [[float(v) for v in row] for row in mb.rig_from_sensor.matrix], "time_offset_s": mb.time_offset_s}
 
 
 def _placement(p, frame: str) -> tuple[str, Any]:
@@ -265,6 +270,9 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
         d["lights"] = [_light(li) for li in spec.lights]
     if spec.cameras:
         d["cameras"] = {k: _camera(c) for k, c in spec.cameras.items()}
+    for kind in section_kinds():  # the other sensor kinds' sections, before the rigs naming them
+        if sensors := kind.sensors_of(spec):
+            d[kind.section] = {k: kind.to_yaml(v) for k, v in sensors.items()}
     if spec.rigs:
         d["rigs"] = {k: _rig(r) for k, r in spec.rigs.items()}
     if spec.view_sets:

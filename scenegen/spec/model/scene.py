@@ -29,6 +29,9 @@ class SceneSpec:
     lights: tuple[Light, ...] = part((), unit="the `lights:` list")
     cameras: Mapping[str, CameraSpec] = part(default_factory=frozen_mapping, unit="by name")
     rigs: Mapping[str, Rig] = part(default_factory=frozen_mapping, unit="by name")
+    sensors: Mapping[str, Mapping[str, Any]] = part(default_factory=frozen_mapping, unit="the sensors of "
+                                                    "the kinds other than cameras (scenegen.spec.sensors), "
+                                                    "by kind, then by name")
     view_sets: tuple[ViewSet, ...] = part((), unit="the `views:` list")
     file: str | None = part(None, unit="the spec file as named by the user ('<string>' for text)")
     base_dir: Path = part(default_factory=Path.cwd, unit="directory relative paths resolve "

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import sys
 from dataclasses import MISSING
 from pathlib import Path
 from types import MappingProxyType
@@ -22,6 +23,10 @@ from scenegen.spec import model as m
 from scenegen.spec import parse_spec, reference
 from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_fields
 from scenegen.spec.parse.read import read_float
+from scenegen.spec.sensors import SENSOR_KINDS
+
+sys.path.insert(0, str(Path(__file__).parent))
+from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
 
 ROOT = Path(__file__).resolve().parents[3]
 PARSE_DIR = ROOT / "scenegen" / "spec" / "parse"
@@ -175,7 +180,19 @@ CASES = [
     *[(m.JointSpec, k, SEQ + JOINT, lambda s, k=k: getattr(s.objects[1].animation.joint, k), v)
       for k, v in (("origin", (0.1, 0.0, 0.0)), ("interpolation", "linear"))],
 ]
+#: A camera and a clock of one name: a member naming it is either, as its kind says.
+CLK = "cameras:\n  clk: {size: [64, 48], fx: 50}\nclocks:\n  clk: {}\nrigs:\n  r: {type: multi, members: [%s]}\n"
+CASES += [
+    (m.RigMember, "kind", CLK % "{sensor: clk}", lambda s: s.rigs["r"].members[0].kind, "clock"),
+    (m.RigMember, "time_offset_s", CLK % "{kind: clock, sensor: clk}",
+     lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
+]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
+
+
+@pytest.fixture(autouse=True)
+def clock_kind(monkeypatch):
+    monkeypatch.setitem(SENSOR_KINDS, CLOCK.name, CLOCK)
 
 
 def parse(text, tmp_path):
