@@ -20,7 +20,7 @@ from scenegen.crossview.motion import moved_stereo_correspondence
 from scenegen.dataset.sequence import StereoMotionTruth
 from scenegen.geometry.rectify import Rectification, rectify
 from scenegen.pipeline.pairs import streams
-from scenegen.pipeline.view import correspond_fn
+from scenegen.pipeline.view import correspond_fn, view_time
 
 
 def stereo_pairs(spec, views, complete: set, steps) -> list[tuple[int, tuple, tuple]]:
@@ -64,8 +64,7 @@ class StereoSequence:
         left = frame[0]
         if left.name not in self._frames:
             rect = self.rectification(frame)
-            self.built.set_time(getattr(left, "time_s", None))
-            t = self.built.truth(rect.camera, rect.cam_left_from_world)
+            t = self.built.truth(rect.camera, rect.cam_left_from_world, time_s=view_time(left))
             P = np.where(t["valid"][..., None], t["points_world"], np.nan)
             self._frames[left.name] = (rect, P, t["object_id"].copy())
             while len(self._frames) > self.keep_frames:

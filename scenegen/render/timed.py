@@ -13,7 +13,7 @@ placed at tau; only the float32 rounding differs (of the moved ray instead of th
 vertices). Normals come back into the world with ``R^T``. An object absent at tau
 (``visible_s``) is not hit.
 
-Built on first use (:meth:`scenegen.render.scene.LoadedScene.timed`): scenes without a rolling
+Built on first use (:meth:`scenegen.render.device.DeviceScene.timed`): scenes without a rolling
 shutter and a moving object never pay for it.
 """
 from __future__ import annotations
