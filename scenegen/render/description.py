@@ -157,7 +157,8 @@ def _parts(obj, key: str, world: trimesh.Trimesh, smooth: bool) -> tuple[MeshPar
     normals = np.asarray(world.vertex_normals) if smooth else None
     out = []
     for i, p in enumerate(parts):
-        vs, fs = slice(p.vertex_start, p.vertex_start + p.vertex_count), slice(p.face_start, p.face_start + p.face_count)
+        vs = slice(p.vertex_start, p.vertex_start + p.vertex_count)
+        fs = slice(p.face_start, p.face_start + p.face_count)
         sub = trimesh.Trimesh(vertices=world.vertices[vs], faces=world.faces[fs] - p.vertex_start, process=False)
         if normals is not None:
             sub.vertex_normals = normals[vs]
