@@ -40,9 +40,10 @@ COMMANDS: tuple[Command, ...] = (
     Command("normals", "normal maps (photometric stereo): DiLiGenT mean/median angular error, < 10/20/30 deg; "
                        "albedo up to scale; light directions", "photometric"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
-    Command("sweep", "F estimators over noise and outliers on exact truth: mean/std epipolar distance, breakdown",
-            "sweep", description="Sweep F estimators over Gaussian noise and outlier fractions drawn from DATASET's "
-                                 "exact truth of a view pair (docs/fmatrix_survey.md)."),
+    Command("sweep", "F, H, E, PnP or triangulation estimators over noise and outliers on exact truth: per-cell "
+                     "error statistics, breakdown points", "sweep",
+            description="Sweep estimators of one kind (--kind f, h, e, pnp, triangulation) over Gaussian noise and "
+                        "outlier fractions drawn from DATASET's exact truth (docs/fmatrix_survey.md, docs/sweeps.md)."),
     Command("homography", "homography: mean corner error, accuracy and AUC", "twoview"),
     Command("calibration", "intrinsics: fx/fy/cx/cy errors, projection difference field, reprojection RMS", "camera"),
     Command("pnp", "absolute pose: rotation angle, translation error, reprojection RMS", "camera"),

@@ -1,7 +1,8 @@
-"""A sweep's report (``recon-eval sweep``; docs/fmatrix_survey.md): the figures of error against
-noise and against outliers per method family, and the Markdown tables (``--markdown``) of the mean
-and standard deviation of the point-to-epipolar-line distance per method and cell and of the
-breakdown points."""
+"""A sweep's report (``recon-eval sweep``; docs/fmatrix_survey.md, docs/sweeps.md): the figures of
+error against noise and against outliers per method family, and the Markdown tables
+(``--markdown``) of the mean and standard deviation of the kind's error (for F the
+point-to-epipolar-line distance) per method and cell and of the breakdown points. What the error
+is comes from the results' ``error`` (:func:`recon_eval.sweep.run.error_of`)."""
 from __future__ import annotations
 
 import math
@@ -9,8 +10,21 @@ import math
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
 
-#: Errors above this (px) are drawn at it in the plots.
+#: Errors above this (the kind's unit) are drawn at it in the plots.
 PLOT_CEILING_PX = 1000.0
+#: What a sweep document written before the sweep kinds reports (F alone, ``breakdown_px``).
+F_ERROR = {"kind": "f", "label": "fundamental matrix", "measure": "distance of the truth points to the estimated "
+           "epipolar lines, px", "unit": "px", "mean_key": "epi_mean_px", "std_key": "epi_std_px",
+           "median_key": "median_trial_epi_px"}
+
+
+def results_error(results: dict) -> dict:
+    """What a sweep's cells report (its ``error``; F's for a document from before the kinds)."""
+    return results.get("error", F_ERROR)
+
+
+def _threshold(cfg: dict) -> float:
+    return cfg["breakdown"] if "breakdown" in cfg else cfg["breakdown_px"]
 
 
 def _px(v) -> str:
@@ -20,16 +34,17 @@ def _px(v) -> str:
     return f"{v:.3g}"
 
 
-def _entry(c) -> str:
-    mean = _px(c["epi_mean_px"])
-    return mean if mean == "fail" else f"{mean} ± {_px(c['epi_std_px'])}"
+def cell_entry(c, err) -> str:
+    """``mean ± std`` of a cell's error (``err``: :func:`results_error`), or "fail"."""
+    mean = _px(c[err["mean_key"]])
+    return mean if mean == "fail" else f"{mean} ± {_px(c[err['std_key']])}"
 
 
 def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str | None = None) -> str:
     """Rows: methods; columns: the swept sigmas at ``outlier_fraction`` (or the fractions at
-    ``sigma_px``); each entry ``mean ± std`` px of the distances to the epipolar lines, or the
-    cell's ``key`` (e.g. ``pose_err_deg``) when given."""
-    cells = results["cells"]
+    ``sigma_px``); each entry ``mean ± std`` of the kind's error (F: px of the distances to the
+    epipolar lines), or the cell's ``key`` (e.g. ``pose_err_deg``) when given."""
+    cells, err = results["cells"], results_error(results)
     if outlier_fraction is not None:
         cells = [c for c in cells if c["outlier_fraction"] == outlier_fraction]
         axis, head = "sigma_px", "sigma {} px"
@@ -45,7 +60,7 @@ def cells_table(results: dict, *, outlier_fraction=None, sigma_px=None, key: str
         fam = next(c["family"] for c in cells if c["method"] == m)
         vals = [by.get((m, v)) for v in cols]
         lines.append(f"| `{m}` | {fam} | " + " | ".join(
-            "" if c is None else (_entry(c) if key is None else _px(c[key])) for c in vals) + " |")
+            "" if c is None else (cell_entry(c, err) if key is None else _px(c[key])) for c in vals) + " |")
     return "\n".join(lines)
 
 
@@ -72,23 +87,28 @@ def breakdown_table(results: dict) -> str:
 def markdown(results: dict) -> str:
     """Every table of a sweep: per outlier fraction (error vs noise), per sigma (error vs outliers),
     and the breakdown points."""
-    cfg = results["config"]
-    parts = [f"Breakdown: the smallest outlier fraction whose median trial error exceeds {cfg['breakdown_px']} px.",
-             "", breakdown_table(results), ""]
+    cfg, err = results["config"], results_error(results)
+    parts = [f"Breakdown: the smallest outlier fraction whose median trial error exceeds {_threshold(cfg)} "
+             f"{err['unit']}.", "", breakdown_table(results), ""]
+    what = ("the truth points' distances to the epipolar lines" if err["kind"] == "f"
+            else f"the per-trial {err['measure'].split(',')[0]}")
     for f in cfg["outlier_fractions"]:
-        parts += [f"Mean ± std (px) of the truth points' distances to the epipolar lines, {f:.0%} outliers:", "",
+        parts += [f"Mean ± std ({err['unit']}) of {what}, {f:.0%} outliers:", "",
                   cells_table(results, outlier_fraction=f), ""]
-    for f in cfg["outlier_fractions"]:
-        parts += [f"Median over the trials of the pose error through the truth K (deg), {f:.0%} outliers:", "",
-                  cells_table(results, outlier_fraction=f, key="pose_err_deg"), ""]
+    if err["kind"] == "f":
+        for f in cfg["outlier_fractions"]:
+            parts += [f"Median over the trials of the pose error through the truth K (deg), {f:.0%} outliers:", "",
+                      cells_table(results, outlier_fraction=f, key="pose_err_deg"), ""]
     return "\n".join(parts)
 
 
 def figures(results: dict) -> list[Figure]:
     """Error against noise (no outliers), and against the outlier fraction at each sigma, one panel per
     method family."""
-    cells, cfg = results["cells"], results["config"]
+    cells, cfg, err = results["cells"], results["config"], results_error(results)
     fam = {c["method"]: c["family"] for c in cells}
+    unit = err["unit"]
+    what = "distance to epipolar line" if err["kind"] == "f" else err["measure"].split(",")[0].split(":")[0]
 
     def panels(fixed_key, fixed, axis, value_key):
         out: dict = {}
@@ -99,13 +119,12 @@ def figures(results: dict) -> list[Figure]:
 
     sig, fr = sorted(cfg["sigmas_px"]), sorted(cfg["outlier_fractions"])
     figs = [Figure("Error against noise", plots.panels_figure(
-        sig, panels("outlier_fraction", fr[0], "sigma_px", "epi_mean_px"), xlabel="sigma (px)",
-        ylabel="mean distance to epipolar line (px)", title=f"{fr[0]:.0%} outliers", ceiling=PLOT_CEILING_PX),
-        "mean over the trials of the truth points' distances to the estimated epipolar lines; open markers: failed "
-        f"or above {PLOT_CEILING_PX:g} px")]
+        sig, panels("outlier_fraction", fr[0], "sigma_px", err["mean_key"]), xlabel="sigma (px)",
+        ylabel=f"mean {what} ({unit})", title=f"{fr[0]:.0%} outliers", ceiling=PLOT_CEILING_PX),
+        f"mean over the trials of the {err['measure']}; open markers: failed or above {PLOT_CEILING_PX:g} {unit}")]
     for s in sig:
         figs.append(Figure(f"Error against outliers, sigma {s:g} px", plots.panels_figure(
-            fr, panels("sigma_px", s, "outlier_fraction", "median_trial_epi_px"), xlabel="outlier fraction",
-            ylabel="median trial distance (px)", title=f"sigma {s:g} px", ceiling=PLOT_CEILING_PX,
-            hline=cfg["breakdown_px"]), f"dashed: the breakdown threshold {cfg['breakdown_px']:g} px"))
+            fr, panels("sigma_px", s, "outlier_fraction", err["median_key"]), xlabel="outlier fraction",
+            ylabel=f"median trial error ({unit})", title=f"sigma {s:g} px", ceiling=PLOT_CEILING_PX,
+            hline=_threshold(cfg)), f"dashed: the breakdown threshold {_threshold(cfg):g} {unit}"))
     return figs

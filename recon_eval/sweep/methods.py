@@ -107,5 +107,26 @@ def resolve(names, declared: dict, notes: RunOutput) -> list[SweepMethod]:
     return out
 
 
+def builtin_resolver(kind: str, builtin: dict) -> Callable:
+    """``resolve(names, declared, notes)`` of a sweep kind with only the built-in methods ``builtin``
+    (name -> :class:`SweepMethod`, ``fit(trial, truth, seed, workdir)``): InputError for another name,
+    a name given twice, or a user's command (the external contract's kinds are F's)."""
+
+    def resolve(names, declared, notes) -> list[SweepMethod]:
+        if declared:
+            raise InputError(f"sweep --kind {kind}: --command / --methods-file take F methods only (--kind f): the "
+                             f"external-command contract has no {kind} output")
+        out = []
+        for name in names:
+            if name not in builtin:
+                raise InputError(f"sweep --kind {kind}: unknown method {name!r}: expected one of {', '.join(builtin)}")
+            out.append(builtin[name])
+        if len(set(names)) != len(names):
+            raise InputError("sweep: a method is named twice")
+        return out
+
+    return resolve
+
+
 def all_survey() -> list[str]:
     return [SURVEY_PREFIX + n for n in ESTIMATORS]

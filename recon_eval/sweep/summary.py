@@ -14,6 +14,13 @@ trials of each trial's mean distance (a failed trial counts as inf); ``success_r
 of trials with a usable F whose mean distance is at most the breakdown threshold. The breakdown
 point of a method at a sigma is the smallest swept outlier fraction whose
 ``median_trial_epi_px`` exceeds the threshold (None: none did).
+
+The other kinds (:mod:`recon_eval.sweep.kinds`) score one error per trial (the kind's
+``error_key``: H's mean corner error, E's pose error, PnP's reprojection of the truth points,
+triangulation's mean 3D error), on the trial's inlier truth; :func:`summarise_scores` gives a cell
+the mean and std of those per-trial errors over the usable trials, their median over all trials
+(a failure counts as inf), the medians of the secondary scores, and the success rate; the
+breakdown point is defined as for F on ``median_trial_<error_key>``.
 """
 from __future__ import annotations
 
@@ -52,15 +59,28 @@ def summarise_cell(trials: list[dict], breakdown_px: float) -> dict:
             "n_failed": len(trials) - len(ok)}
 
 
-def breakdown_points(cells: list[dict], breakdown_px: float) -> list[dict]:
-    """Per method and sigma: the smallest outlier fraction whose median trial error exceeds
-    ``breakdown_px`` (None when none did), with the largest fraction swept."""
+def summarise_scores(trials: list[dict], breakdown: float, key: str, extras: tuple) -> dict:
+    """Cell statistics (module docstring) of trials scored by one error ``key``, and the medians of
+    the secondary scores ``extras``."""
+    ok = [t for t in trials if not t["failed"]]
+    vals = np.array([t[key] for t in ok], np.float64)
+    mean, std = (float(np.mean(vals)), float(np.std(vals))) if ok else (math.inf, math.inf)
+    med = lambda k: float(np.median([t[k] for t in trials]))  # noqa: E731  (failed: inf)
+    return {f"mean_{key}": mean, f"std_{key}": std, f"median_trial_{key}": med(key),
+            **{f"median_{k}": med(k) for k in extras},
+            "success_rate": sum(t[key] <= breakdown for t in ok) / len(trials), "n_failed": len(trials) - len(ok)}
+
+
+def breakdown_points(cells: list[dict], breakdown_px: float, key: str = "median_trial_epi_px") -> list[dict]:
+    """Per method and sigma: the smallest outlier fraction whose median trial error (``key``) exceeds
+    ``breakdown_px`` (the threshold, in the kind's unit; None when none did), with the largest
+    fraction swept."""
     out = {}
     for c in sorted(cells, key=lambda c: c["outlier_fraction"]):
-        key = (c["method"], c["sigma_px"])
-        row = out.setdefault(key, {"method": c["method"], "family": c["family"], "sigma_px": c["sigma_px"],
-                                   "breakdown_fraction": None, "max_fraction_swept": c["outlier_fraction"]})
+        row = out.setdefault((c["method"], c["sigma_px"]), {
+            "method": c["method"], "family": c["family"], "sigma_px": c["sigma_px"], "breakdown_fraction": None,
+            "max_fraction_swept": c["outlier_fraction"]})
         row["max_fraction_swept"] = c["outlier_fraction"]
-        if row["breakdown_fraction"] is None and not c["median_trial_epi_px"] <= breakdown_px:
+        if row["breakdown_fraction"] is None and not c[key] <= breakdown_px:
             row["breakdown_fraction"] = c["outlier_fraction"]
     return list(out.values())

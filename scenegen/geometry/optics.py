@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from scenegen.geometry.camera import Camera
+from scenegen.geometry.clock import Composed, ConstantTwist, Shifted, StaticTrajectory
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.rotation import matrix_from_rotvec
 
@@ -44,16 +45,21 @@ class Shutter:
     exposure_s: float = 0.0  # integration time of the motion blur, seconds (0 = instantaneous)
     rolling_readout_s: float = 0.0  # top row to bottom row start delay, seconds (0 = global shutter)
 
-    def row_time_s(self, v, height: int):
-        """Time of row ``v`` (px, OpenCV rows) relative to the middle row, seconds."""
+    def row_times_s(self, rows, height: int):
+        """Times (seconds from the middle row's, the frame time) of rows ``rows`` (px, continuous
+        OpenCV rows, any shape): ``rolling_readout_s * (v / (H - 1) - 0.5)``; 0 for a global shutter."""
         if height <= 1 or self.rolling_readout_s == 0.0:
-            return 0.0 * np.asarray(v, dtype=np.float64)
-        return self.rolling_readout_s * (np.asarray(v, dtype=np.float64) / (height - 1) - 0.5)
+            return 0.0 * np.asarray(rows, dtype=np.float64)
+        return self.rolling_readout_s * (np.asarray(rows, dtype=np.float64) / (height - 1) - 0.5)
 
-    def row_of_time(self, tau_s, height: int):
-        """The row (px, continuous) exposed ``tau_s`` seconds from the middle row: the inverse of
-        :meth:`row_time_s` (a rolling shutter only)."""
-        return (np.asarray(tau_s, dtype=np.float64) / self.rolling_readout_s + 0.5) * (height - 1)
+    def rows_of_times_s(self, taus_s, height: int):
+        """The rows (px, continuous) exposed ``taus_s`` seconds from the middle row: the inverse of
+        :meth:`row_times_s` (a rolling shutter only)."""
+        return (np.asarray(taus_s, dtype=np.float64) / self.rolling_readout_s + 0.5) * (height - 1)
+
+    # the names other modules use
+    row_time_s = row_times_s
+    row_of_time = rows_of_times_s
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -76,6 +82,17 @@ class Motion:
         """The displacement after ``tau_s`` seconds: rotation exp(omega tau), translation v tau."""
         R = matrix_from_rotvec(self.angular_velocity_rad_s * tau_s)
         return Rigid3(R, np.asarray(self.linear_velocity_mps, dtype=np.float64) * tau_s)
+
+    def camera_trajectory(self, world_from_cam_mid: Rigid3, time_s: float = 0.0) -> ConstantTwist:
+        """The camera's ``world_from_cam`` on the clock (:class:`scenegen.geometry.clock.ConstantTwist`;
+        ``time_s``: the frame time, mid-exposure): the poses of :func:`cam_from_world_at`, inverted."""
+        return ConstantTwist.from_body_velocities(world_from_cam_mid, time_s, self.linear_velocity_mps,
+                                                  self.angular_velocity_rad_s)
+
+    def object_trajectory(self, world_from_object_mid: Rigid3, time_s: float = 0.0) -> ConstantTwist:
+        """An object's ``world_from_object`` on the clock: the poses of :func:`world_from_object_at`."""
+        return ConstantTwist(world_from_object_mid, float(time_s),
+                             np.asarray(self.linear_velocity_mps, np.float64), self.angular_velocity_rad_s)
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,6 +117,11 @@ class PathMotion:
 
     def world_from_cam(self, tau_s: float) -> Rigid3:
         return self.trajectory.pose(self.time_s + float(tau_s)) @ self.x_from_cam
+
+    def world_from_cam_trajectory(self) -> Shifted:
+        """The camera's ``world_from_cam`` as a :class:`scenegen.geometry.clock.Trajectory` read in
+        seconds from the frame time (tau), velocities and accelerations included."""
+        return Shifted(Composed(self.trajectory, StaticTrajectory(self.x_from_cam)), self.time_s)
 
     def delta(self, tau_s: float) -> Rigid3:
         """The displacement after ``tau_s`` seconds in the camera's own frame at the frame time:

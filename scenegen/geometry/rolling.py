@@ -1,9 +1,12 @@
-"""Rolling shutter: poses tabulated per image row, and where a rolling-shutter camera images a point.
+"""Rolling shutter: rows as times, poses tabulated per image row, and where a rolling-shutter
+camera images a point.
 
 Row ``v`` (continuous, OpenCV pixel rows, 0 = top) of a frame is exposed around
-``tau(v) = Shutter.row_time_s(v, H)`` seconds from the frame's time (its middle row at 0; the one
+``tau(v) = Shutter.row_times_s(v, H)`` seconds from the frame's time (its middle row at 0; the one
 definition, :mod:`scenegen.geometry.optics`; the renderer's sensor times its samples by the same
-line). Poses within a frame (the camera's ``world_from_cam``, a moving object's
+line); :class:`RowClock` puts the rows on the sequence clock (:mod:`scenegen.geometry.clock`), so a
+table is a trajectory evaluated at the row times (:meth:`RowPoses.of_trajectory`) and is read
+by row or by time. Poses within a frame (the camera's ``world_from_cam``, a moving object's
 ``world_from_object``: a frame's rotation and its origin's path) are tabulated at the row
 centres from one row above the image to one below, nodes ``v = -1 .. H``, plus a node (a knot)
 at the row of every keyframe time that falls inside the frame's readout, where a path's velocity
@@ -38,17 +41,47 @@ ROW_TOL_PX = 1e-9
 MAX_ITERATIONS = 60
 
 
+@dataclass(frozen=True)
+class RowClock:
+    """A frame's image rows on the clock: row ``v`` (continuous) is exposed at
+    ``frame_time_s + shutter.row_times_s(v, height)`` seconds (:class:`~scenegen.geometry.optics.Shutter`;
+    ``frame_time_s`` the middle row's time: a sequence frame's ``time_s``, 0 for a still spec)."""
+
+    shutter: object  # scenegen.geometry.optics.Shutter
+    height: int
+    frame_time_s: float = 0.0
+
+    def times_s(self, rows) -> np.ndarray:
+        """(N,) times (seconds on the clock) of rows (N,)."""
+        return self.frame_time_s + self.shutter.row_times_s(np.asarray(rows, np.float64), self.height)
+
+    def rows(self, times_s) -> np.ndarray:
+        """(N,) rows exposed at times (N,) seconds on the clock (the inverse of :meth:`times_s`)."""
+        return self.shutter.rows_of_times_s(np.asarray(times_s, np.float64) - self.frame_time_s, self.height)
+
+
 @dataclass(frozen=True, eq=False)
 class RowPoses:
     """Rigid poses at the row nodes of one frame: ``first_row + k`` (k = 0 .. n-1), or the
     strictly increasing rows ``node_rows`` (n,) (uniform nodes with knots, module docstring).
 
-    ``R`` (n, 3, 3), ``t`` (n, 3): the pose (x_from_y, any pair of frames) at each node."""
+    ``R`` (n, 3, 3), ``t`` (n, 3): the pose (x_from_y, any pair of frames) at each node.
+    ``clock`` (:class:`RowClock`, optional): the rows' times, so the table is read by time
+    (:meth:`poses_at`): a trajectory evaluated at the shutter's row times (:meth:`of_trajectory`)."""
 
     R: np.ndarray
     t: np.ndarray
     first_row: float = -1.0
     node_rows: np.ndarray | None = None
+    clock: RowClock | None = None
+
+    @classmethod
+    def of_trajectory(cls, trajectory, clock: RowClock, node_rows) -> RowPoses:
+        """``trajectory`` (:class:`scenegen.geometry.clock.Trajectory`, world_from_x) evaluated at
+        the times of rows ``node_rows`` (n,): each node's pose is the trajectory's, exactly."""
+        rows = np.asarray(node_rows, np.float64)
+        R, t = trajectory.poses_at(clock.times_s(rows))
+        return cls(R, t, node_rows=rows, clock=clock)
 
     def __post_init__(self):
         R, t = np.asarray(self.R, np.float64), np.asarray(self.t, np.float64)
@@ -68,6 +101,8 @@ class RowPoses:
         object.__setattr__(self, "_f", rows - rows[0])
         # the geodesic step of each interval, in the frame of its first node
         object.__setattr__(self, "_w", rotvec_from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]))
+        # the nodes' times: a time computed from a node's row by the same clock lands on it exactly
+        object.__setattr__(self, "_times", None if self.clock is None else self.clock.times_s(rows))
 
     def interval(self, v) -> tuple[np.ndarray, np.ndarray]:
         """((N,) node index k, (N,) fraction a in [0, 1]) of rows ``v`` (N,): v lies between nodes
@@ -75,6 +110,22 @@ class RowPoses:
         f = np.clip(np.asarray(v, np.float64) - self.first_row, 0.0, self._f[-1])
         k = np.minimum(np.searchsorted(self._f, f, side="right") - 1, len(self._f) - 2)
         return k, (f - self._f[k]) / (self._f[k + 1] - self._f[k])
+
+    def _interval_at_times(self, times_s) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`interval` of times (N,) seconds on the clock, the fraction taken in time."""
+        if self._times is None:
+            raise ValueError("RowPoses: reading poses by time needs the rows' clock (RowClock)")
+        T = self._times
+        if T[-1] == T[0]:  # a global shutter: every row at the frame time
+            raise ValueError("RowPoses: a table over rows all exposed at one time cannot be read by time")
+        f = np.clip(np.asarray(times_s, np.float64).reshape(-1), T[0], T[-1])
+        k = np.minimum(np.searchsorted(T, f, side="right") - 1, len(T) - 2)
+        return k, (f - T[k]) / (T[k + 1] - T[k])
+
+    def poses_at(self, times_s) -> tuple[np.ndarray, np.ndarray]:
+        """((N, 3, 3), (N, 3)) the poses at times (N,) seconds on the clock (:meth:`at` by time;
+        a node's own time gives its pose exactly)."""
+        return self._interpolate(*self._interval_at_times(times_s))
 
     def nearest_node(self, v) -> np.ndarray:
         """(N,) index of the node nearest to each of rows ``v`` (N,) (a tie: the lower node)."""
@@ -84,7 +135,9 @@ class RowPoses:
     def at(self, v) -> tuple[np.ndarray, np.ndarray]:
         """((N, 3, 3), (N, 3)) the poses at rows ``v`` (N,), interpolated between the nodes
         (module docstring); rows beyond the nodes take the end nodes' poses."""
-        k, a = self.interval(v)
+        return self._interpolate(*self.interval(v))
+
+    def _interpolate(self, k, a) -> tuple[np.ndarray, np.ndarray]:
         R = self.R[k] @ matrix_from_rotvec(a[:, None] * self._w[k]).reshape(-1, 3, 3)
         t = self.t[k] + a[:, None] * (self.t[k + 1] - self.t[k])
         return R, t
@@ -161,6 +214,7 @@ class RollingRows:
     cam: RowPoses
     objects: dict
     present: dict
+    clock: RowClock | None = None  # the rows' times (then moves can be asked by time)
 
     @property
     def height(self) -> int:
@@ -177,6 +231,16 @@ class RollingRows:
             k = self.pixel_rows()
             return {oid: (rp.R[k], rp.t[k], self.present[oid][k]) for oid, rp in self.objects.items()}
         return {oid: self.object_pose(oid, rows) for oid in self.objects}
+
+    def object_moves_at_times(self, times_s) -> dict:
+        """{object id: ((N, 3, 3) R, (N, 3) t world_from_object, (N,) present)} at times (N,)
+        seconds on the clock (a ray's own time: its row's, a beam's, an event's), interpolated in
+        time between the row nodes; present at the nearest node."""
+        out = {}
+        for oid, rp in self.objects.items():
+            k, a = rp._interval_at_times(times_s)
+            out[oid] = (*rp._interpolate(k, a), self.present[oid][k + (a > 0.5)])
+        return out
 
     def object_pose(self, object_id: int, rows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """((N, 3, 3) R, (N, 3) t world_from_object, (N,) present) of one moving object at

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scenegen.geometry.clock import TrajectoryMixin, TrajectoryStates, as_times
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.rotation import matrix_from_rotvec, rotvec_from_matrix
 
@@ -102,6 +103,48 @@ def _jacobian_coefficients(theta: float) -> tuple[float, float, float, float]:
     return a, b, da, db
 
 
+def _jacobian_coefficients_n(theta: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`_jacobian_coefficients` of (N,) angles (the same series below the same angle)."""
+    t2 = theta * theta
+    small = theta < _SERIES_BELOW_RAD
+    tb = np.where(small, 1.0, theta)  # no 0 / 0 in the branch np.where discards
+    tb2 = tb * tb
+    s, c = np.sin(tb), np.cos(tb)
+    a = np.where(small, 0.5 - t2 / 24 + t2 * t2 / 720 - t2 ** 3 / 40320, (1 - c) / tb2)
+    b = np.where(small, 1 / 6 - t2 / 120 + t2 * t2 / 5040 - t2 ** 3 / 362880, (tb - s) / (tb2 * tb))
+    da = np.where(small, -1 / 12 + t2 / 180 - t2 * t2 / 6720, (tb * s - 2 * (1 - c)) / (tb2 * tb2))
+    db = np.where(small, -1 / 60 + t2 / 1260 - t2 * t2 / 60480,
+                  ((1 - c) * tb - 3 * (tb - s)) / (tb2 * tb2 * tb))
+    return a, b, da, db
+
+
+def exp_derivatives_n(s, s_dot, s_ddot) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`exp_derivatives` of (N, 3) rotation vectors and their derivatives: (N, 3) body
+    angular velocities and accelerations."""
+    s, sd, sdd = (np.asarray(x, np.float64).reshape(-1, 3) for x in (s, s_dot, s_ddot))
+    a, b, da, db = (c[:, None] for c in _jacobian_coefficients_n(np.linalg.norm(s, axis=1)))
+    rate = np.einsum("ni,ni->n", s, sd)[:, None]  # theta * d theta / dt
+    Sv, SSv = np.cross(s, sd), np.cross(s, np.cross(s, sd))  # [s]x sd, [s]x^2 sd
+    w = sd - a * Sv + b * SSv
+    # J_dot sd = -da rate [s]x sd - a [sd]x sd + db rate [s]x^2 sd + b ([sd]x [s]x + [s]x [sd]x) sd
+    j_dot_sd = -da * rate * Sv + db * rate * SSv + b * np.cross(sd, Sv)
+    J_sdd = sdd - a * np.cross(s, sdd) + b * np.cross(s, np.cross(s, sdd))
+    return w, j_dot_sd + J_sdd
+
+
+def _held(times_s: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((N,) bool before the first keyframe, (N,) bool after the last one) of times (N,)."""
+    if len(T) == 1:
+        return np.ones(len(times_s), bool), np.zeros(len(times_s), bool)
+    return times_s < T[0], times_s > T[-1]
+
+
+def _segments(times_s: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((N,) segment k, (N,) fraction u in [0, 1]) of times inside [T_0, T_last] (right-continuous)."""
+    k = np.clip(np.searchsorted(T, times_s, side="right") - 1, 0, len(T) - 2)
+    return k, (times_s - T[k]) / (T[k + 1] - T[k])
+
+
 def exp_derivatives(s, s_dot, s_ddot) -> tuple[np.ndarray, np.ndarray]:
     """Body angular velocity and acceleration of ``R(t) = R_0 exp([s(t)]x)``: (J_r(s) s',
     d/dt (J_r(s) s')), with J_r(s) = I - a [s]x + b [s]x^2."""
@@ -131,8 +174,10 @@ def _unwrapped_rotvecs(rotations) -> np.ndarray:
     return np.array(out)
 
 
-class KeyframeTrajectory:
-    """A frame's keyframed trajectory (poses ``world_from_frame`` at strictly increasing times)."""
+class KeyframeTrajectory(TrajectoryMixin):
+    """A frame's keyframed trajectory (poses ``world_from_frame`` at strictly increasing times);
+    a :class:`scenegen.geometry.clock.Trajectory` (:meth:`states_at`, vectorised; :meth:`state`,
+    one time)."""
 
     def __init__(self, times_s, poses, interpolation: str = "spline"):
         self.times_s = np.asarray(times_s, np.float64).reshape(-1)
@@ -152,6 +197,8 @@ class KeyframeTrajectory:
             CubicSpline = _cubic_spline()
             self._pos = CubicSpline(self.times_s, self._t, bc_type="natural", axis=0)
             self._rot = CubicSpline(self.times_s, _unwrapped_rotvecs(self._R), bc_type="natural", axis=0)
+        if len(self.poses) >= 2 and interpolation == "linear":  # each segment's body rotation step
+            self._w = rotvec_from_matrix(np.swapaxes(self._R[:-1], 1, 2) @ self._R[1:]).reshape(-1, 3)
 
     def __len__(self) -> int:
         return len(self.poses)
@@ -187,8 +234,38 @@ class KeyframeTrajectory:
     def pose(self, t_s: float) -> Rigid3:
         return self.state(t_s).world_from_frame
 
+    def states_at(self, times_s) -> TrajectoryStates:
+        """Poses and world-frame derivatives at ``times_s`` (N,) (module docstring; the same
+        values as :meth:`state` at each time, to rounding)."""
+        t = as_times(times_s)
+        T = self.times_s
+        before, after = _held(t, T)
+        inside = ~(before | after)
+        R = np.where(after[:, None, None], self._R[-1], self._R[0])
+        out = TrajectoryStates.still(R, np.where(after[:, None], self._t[-1], self._t[0]))
+        ti = t[inside]
+        if not len(ti):
+            return out
+        if self.interpolation == "linear":
+            k, u = _segments(ti, T)
+            dt = (T[k + 1] - T[k])[:, None]
+            Rk = self._R[k]
+            out.R[inside] = Rk @ matrix_from_rotvec(u[:, None] * self._w[k]).reshape(-1, 3, 3)
+            out.t[inside] = self._t[k] + u[:, None] * (self._t[k + 1] - self._t[k])
+            out.velocity_mps[inside] = (self._t[k + 1] - self._t[k]) / dt
+            out.angular_velocity_rad_s[inside] = np.einsum("nij,nj->ni", Rk, self._w[k]) / dt
+            return out
+        s, sd, sdd = (self._rot(ti, nu) for nu in (0, 1, 2))
+        Ri = self._R[0] @ matrix_from_rotvec(s).reshape(-1, 3, 3)
+        w_body, a_body = exp_derivatives_n(s, sd, sdd)
+        out.R[inside], out.t[inside] = Ri, self._pos(ti)
+        out.velocity_mps[inside], out.acceleration_mps2[inside] = self._pos(ti, 1), self._pos(ti, 2)
+        out.angular_velocity_rad_s[inside] = np.einsum("nij,nj->ni", Ri, w_body)
+        out.angular_acceleration_rad_s2[inside] = np.einsum("nij,nj->ni", Ri, a_body)
+        return out
 
-class JointTrajectory:
+
+class JointTrajectory(TrajectoryMixin):
     """A joint: ``parent_from_frame(t) = J(q(t)) @ rest``. Revolute: J turns by q (radians) about
     ``axis`` through ``origin`` (parent frame); prismatic: J shifts by q (metres) along ``axis``.
     q(t) is interpolated through keyframe values, linearly or by a natural cubic spline."""
@@ -223,6 +300,38 @@ class JointTrajectory:
         k = min(int(np.searchsorted(T, t, side="right")) - 1, len(T) - 2)
         rate = (q[k + 1] - q[k]) / (T[k + 1] - T[k])
         return float(q[k] + rate * (t - T[k])), float(rate), 0.0
+
+    def _q_derivatives_n(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        T, q = self.times_s, self.values
+        before, after = _held(t, T)
+        inside = ~(before | after)
+        out = [np.where(after, q[-1], q[0]), np.zeros(len(t)), np.zeros(len(t))]
+        ti = t[inside]
+        if self._q is not None:
+            for nu in range(3):
+                out[nu][inside] = self._q(ti, nu)
+        elif len(ti):
+            k, _ = _segments(ti, T)
+            rate = (q[k + 1] - q[k]) / (T[k + 1] - T[k])
+            out[0][inside], out[1][inside] = q[k] + rate * (ti - T[k]), rate
+        return out[0], out[1], out[2]
+
+    def states_at(self, times_s) -> TrajectoryStates:
+        """parent_from_frame and its parent-frame derivatives at ``times_s`` (N,) (vectorised
+        :meth:`state`)."""
+        q, qd, qdd = (x[:, None] for x in self._q_derivatives_n(as_times(times_s)))
+        a, o = self.axis, self.origin
+        n, z = len(q), np.zeros((len(q), 3))
+        if self.joint_type == "prismatic":
+            J = TrajectoryStates(np.broadcast_to(np.eye(3), (n, 3, 3)).copy(), q * a, qd * a, z, qdd * a, z.copy())
+        else:
+            R = matrix_from_rotvec(q * a).reshape(-1, 3, 3)
+            w, alpha = qd * a, qdd * a
+            Ro = R @ o
+            J = TrajectoryStates(R, o - Ro, -np.cross(w, Ro), w,
+                                 -np.cross(alpha, Ro) - np.cross(w, np.cross(w, Ro)), alpha)
+        rest = self.rest
+        return J.compose(TrajectoryStates.still(np.broadcast_to(rest.R, (n, 3, 3)), np.broadcast_to(rest.t, (n, 3))))
 
     def state(self, t_s: float) -> MotionState:
         q, qd, qdd = self._q_derivatives(float(t_s))

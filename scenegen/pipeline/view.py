@@ -14,7 +14,7 @@ import numpy as np
 from scenegen.crossview.correspondence import correspond
 from scenegen.geometry.color import srgb_image
 from scenegen.geometry.optics import PathMotion, cam_from_world_at, motion_to_dict
-from scenegen.geometry.rolling import RollingRows, RowPoses, frame_node_rows
+from scenegen.geometry.rolling import RollingRows, RowClock, RowPoses, frame_node_rows
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.codecs.exr import encode_exr
@@ -80,6 +80,7 @@ def _rows(built, view):
             knots.append(built.timeline.knot_times_s() - time_s)
         nodes = frame_node_rows(shutter, H, np.concatenate(knots) if knots else ())
         taus = shutter.row_time_s(nodes, H)
+        clock = RowClock(shutter, H, 0.0 if time_s is None else float(time_s))  # the rows' times
         pixel = np.searchsorted(nodes, np.arange(H, dtype=np.float64))
         cam = [cam_from_world_at(view.cam_from_world, view.motion, float(tau)) for tau in taus]
         poses = [cam[k] for k in pixel] if camera_moves else None
@@ -87,9 +88,9 @@ def _rows(built, view):
         objects, present = {}, {}
         if built.movers:
             for oid, (R, t, p) in poses_within_frame(built.timeline, time_s, taus).items():
-                objects[oid], present[oid] = RowPoses(R, t, node_rows=nodes), p
+                objects[oid], present[oid] = RowPoses(R, t, node_rows=nodes, clock=clock), p
         rows = RollingRows(RowPoses(np.stack([p.R for p in world_from_cam]), np.stack([p.t for p in world_from_cam]),
-                                    node_rows=nodes), objects, present)
+                                    node_rows=nodes, clock=clock), objects, present, clock)
         cache[key] = (poses, rows)
         while len(cache) > ROWS_KEPT:  # bounded: a long run renders each view once
             cache.popitem(last=False)
@@ -99,11 +100,12 @@ def _rows(built, view):
 def visibility_fn(built, view, rows: RollingRows | None):
     """The visibility cast of a frame (:class:`scenegen.crossview.frames.FrameGeometry`): in the
     scene at the view's time; with a rolling shutter's ``rows``, from each point's row centre
-    with the moving objects at that row's time."""
+    with the moving objects where they are at that row's time (each ray cast at its own time)."""
     time_s = view_time(view)
 
     def visible(centres, points, point_rows=None):
-        moves = rows.object_moves(point_rows) if rows is not None and rows.objects else None
+        moves = (rows.object_moves_at_times(rows.clock.times_s(point_rows))
+                 if rows is not None and rows.objects else None)
         return built.visible_from(centres, points, moves=moves, time_s=time_s)
     return visible
 

@@ -13,6 +13,10 @@ placed at tau; only the float32 rounding differs (of the moved ray instead of th
 vertices). Normals come back into the world with ``R^T``. An object absent at tau
 (``visible_s``) is not hit.
 
+Each ray carries a time (seconds on the sequence clock, :mod:`scenegen.geometry.clock`):
+:func:`timed_first_hit_at_times` places the movers at every ray's own time; a rolling-shutter
+row, a LiDAR beam, an event are all just times.
+
 Built on first use (:meth:`scenegen.render.device.DeviceScene.timed`): scenes without a rolling
 shutter and a moving object never pay for it.
 """
@@ -109,6 +113,17 @@ def timed_first_hit(ts: TimedScenes, origin, direction, moves_jit: dict, alpha_m
         uv = dr.select(closer, uv_k, uv)
         sid = dr.select(closer, sid_k, sid)
     return t, hit, n, uv, sid
+
+
+def timed_first_hit_at_times(ts: TimedScenes, origin, direction, times_s, motions, alpha_masked: bool,
+                             coherent: bool, index=None):
+    """:func:`timed_first_hit` of rays each cast at its own time: ``times_s`` (N,) seconds on the
+    sequence clock (a rolling-shutter row's, a LiDAR beam's, an event's, an IMU sample's), or a
+    table of M times that ``index`` (a mi.UInt32 per ray) gathers from; ``motions``: anything
+    with ``object_moves_at_times(times_s) -> {object id: ((N, 3, 3) R, (N, 3) t world_from_object,
+    (N,) present)}`` (:class:`scenegen.geometry.rolling.RollingRows`, :class:`scenegen.spec.timeline.Timeline`)."""
+    moves = {oid: mv for oid, mv in motions.object_moves_at_times(times_s).items() if oid in ts.movers}
+    return timed_first_hit(ts, origin, direction, upload_moves(ts, moves, index), alpha_masked, coherent)
 
 
 def build_timed(main_entries: dict, mover_entries: dict, references: dict, object_ids: dict,

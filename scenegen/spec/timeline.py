@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scenegen.geometry.clock import Composed, StaticTrajectory, Trajectory, as_times
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.trajectory import MotionState
@@ -29,12 +30,11 @@ class ObjectState:
         return self.motion.world_from_frame
 
 
-class _Fixed:
-    def __init__(self, pose: Rigid3):
-        self.pose_ = pose
+class _Fixed(StaticTrajectory):
+    """A fixed ``rest`` pose, also asked one time at a time (``state``)."""
 
     def state(self, t_s: float) -> MotionState:
-        return MotionState.still(self.pose_)
+        return MotionState.still(self.world_from_body)
 
 
 def local_trajectory(animation):
@@ -96,13 +96,45 @@ class Timeline:
     def knot_times_s(self) -> np.ndarray:
         """(K,) sorted times at which some object's motion may have a velocity jump (its own or
         a parent's keyframes, :attr:`scenegen.geometry.trajectory.KeyframeTrajectory.knot_times_s`)."""
-        times = []
-        for obj in self.objects:
-            if is_animated(obj):
-                if obj.name not in self._cache:
-                    self._cache[obj.name] = local_trajectory(obj.animation)
-                times.append(np.asarray(getattr(self._cache[obj.name], "knot_times_s", ()), np.float64))
+        times = [np.asarray(self._local(obj).knot_times_s, np.float64) for obj in self.objects if is_animated(obj)]
         return np.unique(np.concatenate(times)) if times else np.empty(0)
+
+    def _local(self, obj):
+        if obj.name not in self._cache:
+            self._cache[obj.name] = local_trajectory(obj.animation)
+        return self._cache[obj.name]
+
+    def object_trajectory(self, name: str) -> Trajectory:
+        """``world_from_object`` of object ``name`` as a :class:`scenegen.geometry.clock.Trajectory`
+        (its local trajectory under its parents'; a static object's fixed ``transform``)."""
+        obj = next(o for o in self.objects if o.name == name)
+        if not is_animated(obj):
+            motion = getattr(obj, "motion", None)  # a still spec's clock: 0 at each view's mid-exposure
+            return (motion.object_trajectory(obj.transform.world_from_object) if moves_within_frame(obj)
+                    else StaticTrajectory(obj.transform.world_from_object))
+        local = self._local(obj)
+        parent = obj.animation.parent
+        return Composed(self.object_trajectory(parent), local) if parent is not None else local
+
+    def presence_at(self, name: str, times_s) -> np.ndarray:
+        """(N,) bool: object ``name`` (and each of its parents) exists at times (N,) seconds."""
+        t = as_times(times_s)
+        obj = next(o for o in self.objects if o.name == name)
+        a = getattr(obj, "animation", None)
+        own = np.ones(len(t), bool) if a is None or a.visible_s is None else \
+            (a.visible_s[0] <= t) & (t <= a.visible_s[1])
+        return own & self.presence_at(a.parent, t) if a is not None and a.parent is not None else own
+
+    def object_moves_at_times(self, times_s) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """{object id: ((N, 3, 3) R, (N, 3) t world_from_object, (N,) present)} of every object
+        that moves (:func:`moves_within_frame`) at times (N,) seconds on the clock, one per ray
+        (vectorised over the times)."""
+        out = {}
+        for o in self.objects:
+            if moves_within_frame(o):
+                R, t = self.object_trajectory(o.name).poses_at(times_s)
+                out[o.object_id] = (R, t, self.presence_at(o.name, times_s))
+        return out
 
     def poses_by_id(self, t_s: float) -> dict[int, tuple[Rigid3, bool]]:
         """{object id: (world_from_object, present)} at ``t_s``."""

@@ -96,9 +96,9 @@ def test_every_method_is_exact_without_noise_or_outliers(conclusions):
 def test_linear_and_iterative_cope_with_noise_not_outliers(conclusions):
     for m in ("eight-point-eigen", "fns", "cfns"):
         lo, hi = conclusions[(m, 0.5, 0.0)]["epi_mean_px"], conclusions[(m, 2.0, 0.0)]["epi_mean_px"]
-        assert 0 < lo < hi < CONCLUSIONS.breakdown_px  # noise-sensitive, and below 1 px at 2 px noise
+        assert 0 < lo < hi < CONCLUSIONS.breakdown  # noise-sensitive, and below 1 px at 2 px noise
         assert 2.5 < hi / lo < 6  # about linear in sigma (x4)
-        assert conclusions[(m, 0.5, 0.3)]["median_trial_epi_px"] > 10 * CONCLUSIONS.breakdown_px  # 30 % outliers
+        assert conclusions[(m, 0.5, 0.3)]["median_trial_epi_px"] > 10 * CONCLUSIONS.breakdown  # 30 % outliers
     # FNS/CFNS minimise the Sampson cost: at 2 px their Sampson RMS on the truth is no worse than 8-point's
     eight = conclusions[("eight-point-eigen", 2.0, 0.0)]["sampson_rms_px"]
     assert conclusions[("cfns", 2.0, 0.0)]["sampson_rms_px"] <= 1.05 * eight
@@ -107,7 +107,7 @@ def test_linear_and_iterative_cope_with_noise_not_outliers(conclusions):
 def test_robust_methods_cope_with_both(conclusions):
     for m in ("ransac", "lmeds-eigen", "mapsac"):
         c = conclusions[(m, 0.5, 0.3)]
-        assert c["median_trial_epi_px"] < CONCLUSIONS.breakdown_px and c["success_rate"] == 1.0
+        assert c["median_trial_epi_px"] < CONCLUSIONS.breakdown and c["success_rate"] == 1.0
 
 
 def test_sweep_is_bitwise_reproducible(truth, tmp_path):

@@ -164,3 +164,39 @@ def test_a_child_exists_only_while_its_parent_does(tmp_path):
     tl = Timeline(parse(text, tmp_path))
     assert [tl.states(t)["b"].present for t in (0.0, 0.1, 0.2, 0.3)] == [False, True, True, False]
     assert np.allclose(tl.states(0.0)["b"].world_from_object.t, [0, 0, 1])
+
+
+def test_every_object_is_a_trajectory_on_the_clock(tmp_path):
+    """Timeline.object_trajectory (parents composed) and object_moves_at_times (one time per ray,
+    vectorised) give the per-time states' poses, velocities and presence."""
+    s = parse(CAM + SEQ + OBJECTS + VIEWS, tmp_path)
+    tl = Timeline(s)
+    times = np.concatenate([np.linspace(-0.05, 0.35, 41), [0.1, 0.2, 0.3]])
+    moves = tl.object_moves_at_times(times)
+    assert set(moves) == {o.object_id for o in s.objects}
+    for k, t in enumerate(times):
+        st = tl.states(float(t))
+        for o in s.objects:
+            R, tr, present = moves[o.object_id]
+            want = st[o.name]
+            assert np.abs(R[k] - want.world_from_object.R).max() < 1e-15
+            assert np.abs(tr[k] - want.world_from_object.t).max() < 1e-15 and present[k] == want.present
+            traj = tl.object_trajectory(o.name)
+            assert np.abs(traj.velocity_at(t)[0] - want.motion.linear_velocity_mps).max() < 1e-12
+            assert np.abs(traj.angular_velocity_at(t)[0] - want.motion.angular_velocity_rad_s).max() < 1e-12
+
+
+def test_a_still_specs_moving_object_is_a_trajectory_from_mid_exposure(tmp_path):
+    from scenegen.spec.timeline import poses_within_frame
+
+    text = (CAM + "objects:\n  - {name: m, shape: box, transform: {translation: [0, 0, 1]},\n"
+            "     motion: {linear_velocity_mps: [1, 0, 0], angular_velocity_deg_s: [0, 0, 90]}}\n"
+            "  - {name: still, shape: box}\n"
+            "views:\n  - camera: cam\n    look_at: [{eye: [0, -2, 1], target: [0, 0, 0]}]\n")
+    tl = Timeline(parse(text, tmp_path))
+    taus = np.linspace(-0.01, 0.01, 9)
+    moves = tl.object_moves_at_times(taus)
+    want = poses_within_frame(tl, None, taus)
+    assert set(moves) == set(want) == {tl.objects[0].object_id}
+    for a, b in zip(moves[tl.objects[0].object_id], want[tl.objects[0].object_id]):
+        assert np.abs(np.asarray(a, float) - np.asarray(b, float)).max() < 1e-14
