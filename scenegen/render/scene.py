@@ -93,6 +93,10 @@ class LoadedScene(Caster):
         """The lighting the device was last rendered with (state of Mitsuba's copy, not an input)."""
         return self.device.light_scales
 
+    def timed(self):
+        """The device's still world and one scene per moving object (:meth:`scenegen.render.device.DeviceScene.timed`)."""
+        return self.device.timed()
+
     @property
     def moving(self) -> list:
         return self.device.moving
