@@ -46,8 +46,8 @@ def parse_placement(node: Node, objects_node: Node | None,
     if onto not in by_name:
         raise f.get("onto").error(f"undefined object {onto!r}{suggest(onto, by_name)}; objects: "
                                   f"{', '.join(by_name) or 'none'}")
-    if by_name[onto].animation is not None:
-        raise f.get("onto").error(f"the support {onto!r} moves over the sequence; it must stand still")
+    if by_name[onto].animation is not None or by_name[onto].motion is not None:
+        raise f.get("onto").error(f"the support {onto!r} moves (`motion:` or the sequence); it must stand still")
     names = _dropped_names(f.get("objects"), by_name, onto, objects_node)
     seed = seed_or_none(f, DropPlacement)
     region = _region(f.get("region")) if "region" in f else (None, None)

@@ -95,9 +95,16 @@ SCRIPT = ("import json, sys; from scenegen.spec import load_spec; p = load_spec(
           "print(json.dumps({n: [repr(float(x)) for x in p.poses[n].matrix.ravel()] for n in p.objects}))")
 
 
+def in_parallel(*argvs) -> list[str]:
+    """Run the commands at once (two fresh processes, no shared cache); their stdout."""
+    procs = [subprocess.Popen(argv, stdout=subprocess.PIPE, text=True, cwd=ROOT) for argv in argvs]
+    outs = [p.communicate(timeout=300)[0] for p in procs]
+    assert [p.returncode for p in procs] == [0] * len(procs)
+    return outs
+
+
 def test_the_drop_is_bitwise_deterministic_across_processes(scatter):
-    runs = [subprocess.run([sys.executable, "-c", SCRIPT, str(SCATTER)], capture_output=True, text=True, check=True,
-                           cwd=ROOT).stdout for _ in range(2)]
+    runs = in_parallel(*[[sys.executable, "-c", SCRIPT, str(SCATTER)]] * 2)
     assert runs[0] == runs[1]
     here = {n: [repr(float(x)) for x in scatter.placement.poses[n].matrix.ravel()] for n in scatter.placement.objects}
     assert json.loads(runs[0]) == here
@@ -191,9 +198,8 @@ def test_the_scene_renders_bitwise_deterministically(tmp_path):
     spec = tmp_path / "tabletop_scatter.yaml"
     spec.write_text(SCATTER.read_text().replace("size: [320, 240]", "size: [64, 48]"))
     outs = [tmp_path / "a", tmp_path / "b"]
-    for out in outs:
-        subprocess.run([sys.executable, "-c", "import sys; from scenegen.cli import main; sys.exit(main(sys.argv[1:]))",
-                        "render", str(spec), "-o", str(out), "--spp", "4", "-q"], check=True, cwd=ROOT)
+    in_parallel(*[[sys.executable, "-c", "import sys; from scenegen.cli import main; sys.exit(main(sys.argv[1:]))",
+                   "render", str(spec), "-o", str(out), "--spp", "4", "-q"] for out in outs])
     a, b = ((o / "manifest.json").read_bytes() for o in outs)
     assert a == b and json.loads(a)["files"]
     recorded = json.loads((outs[0] / "cameras.json").read_text())["spec"]["placement"]["poses"]
