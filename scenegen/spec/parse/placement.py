@@ -13,9 +13,9 @@ import dataclasses
 
 import numpy as np
 
+from scenegen.assets.meshes import TARGET_KINDS, object_mesh
 from scenegen.errors import SpecError
 from scenegen.geometry import seeds
-from scenegen.assets.meshes import TARGET_KINDS, object_mesh
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.physics import Body, DropError, DropSettings, bounding_radius, release_poses, settle, support_hull
 from scenegen.spec.model.geometry import Blob, SceneObject, Transform
