@@ -85,6 +85,7 @@ RECORDS = (
     (m.LightVariation, "variation.lights.NAME", {}),
     (m.CameraVariation, "variation.cameras.NAME", {}),
     (m.PoseJitter, "variation.views", {}),
+    (m.DropPlacement, "placement (type: drop)", {}),
 )
 
 

@@ -132,6 +132,7 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
         **({"sequence": _plain(spec.sequence)} if getattr(spec, "sequence", None) is not None else {}),
         **({"truth": _plain(spec.truth)} if getattr(spec, "truth", None) is not None else {}),
+        **({"placement": _plain(spec.placement)} if getattr(spec, "placement", None) is not None else {}),
     }
 
 

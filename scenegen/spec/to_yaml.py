@@ -254,6 +254,15 @@ def _variation(v) -> dict:
     return d
 
 
+def _placement_section(p: m.DropPlacement) -> dict:
+    """The drop with its settled poses (4x4 rows, bit-exact): parsed back without the engine."""
+    d: dict[str, Any] = {"type": p.type, "objects": list(p.objects), **write_fields(p)}
+    if p.region_min is not None:
+        d["region"] = {"min": _v(p.region_min), "max": _v(p.region_max)}
+    d["poses"] = {name: _pose_rows(pose) for name, pose in p.poses.items()}
+    return d
+
+
 def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     """The spec as the plain data its YAML holds (every value explicit)."""
     if spec.variant is not None:
@@ -266,6 +275,11 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
         d["materials"] = {k: _material(v) for k, v in spec.materials.items()}
     if spec.objects:
         d["objects"] = [_object(o, spec.materials) for o in spec.objects]
+    if spec.placement is not None:  # a dropped object's pose is the recorded one: its scale only
+        for o in d["objects"]:
+            if o["name"] in spec.placement.poses:
+                o["transform"] = {"scale": o["transform"]["scale"]}
+        d["placement"] = _placement_section(spec.placement)
     if spec.lights:
         d["lights"] = [_light(li) for li in spec.lights]
     if spec.cameras:

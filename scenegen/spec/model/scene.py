@@ -10,6 +10,7 @@ from scenegen.spec.model.crossview import CrossviewSpec
 from scenegen.spec.model.geometry import SceneObject
 from scenegen.spec.model.lights import Light
 from scenegen.spec.model.materials import Material
+from scenegen.spec.model.placement import DropPlacement
 from scenegen.spec.model.meta import SEED_MAX, frozen_mapping, param, part
 from scenegen.spec.model.render import RenderSettings
 from scenegen.spec.model.truth import TruthSpec
@@ -45,6 +46,9 @@ class SceneSpec:
                                     "sequence; None = a static scene")
     truth: TruthSpec | None = part(None, unit="per-view truth written on request (albedo, "
                                              "lights); None = none", omit_default=True)
+    placement: DropPlacement | None = part(None, unit="objects dropped onto a support and settled "
+                                                     "(their settled poses recorded); None = none",
+                                                omit_default=True)
     variant: Mapping[str, Any] | None = part(None, unit="a derived variant's index, seed and "
                                                         "drawn values "
                                                         "(scenegen.spec.variants.derive_variant); "

@@ -20,6 +20,7 @@ from scenegen.spec.parse.crossview import check_pair_views, parse_crossview
 from scenegen.spec.parse.lights import parse_light
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.objects import parse_object
+from scenegen.spec.parse.placement import check_variation, parse_placement
 from scenegen.spec.parse.read import read_int
 from scenegen.spec.parse.render import parse_render
 from scenegen.spec.parse.rigs import parse_rig
@@ -31,7 +32,7 @@ from scenegen.spec.sensors import SENSOR_KINDS, STREAM, section_kinds, stream_na
 from scenegen.spec.views import resolve_views, view_members
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth")
+                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth", "placement")
 #: Scene name of spec text that comes from no file.
 TEXT_SCENE_NAME = "scene"
 
@@ -65,6 +66,10 @@ def parse_document(doc: Document) -> SceneSpec:
         objects.append(parse_object(item, i, ctx.but(objects=tuple(objects))))
     unique_names(f.get("objects"), objects, "object")
     ctx = ctx.but(objects=tuple(objects))
+    placement = None
+    if "placement" in f:  # the dropped objects at their settled poses from here on
+        placement, placed = parse_placement(f.get("placement"), f.get("objects"), ctx)
+        ctx = ctx.but(objects=placed)
     lights = list_section(f, "lights", parse_light, ctx)
     unique_names(f.get("lights"), lights, "light")
     ctx = ctx.but(lights=tuple(lights))  # named by view sets' `lights:`
@@ -75,12 +80,14 @@ def parse_document(doc: Document) -> SceneSpec:
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
     truth = parse_truth(f.get("truth"), ctx) if "truth" in f else None
+    if placement is not None:
+        check_variation(placement, variation, ctx.objects)
     spec = SceneSpec(
         name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
         rigs=ctx.rigs, sensors=ctx.sensors, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
         warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
-        truth=truth)
+        truth=truth, placement=placement)
     if truth is not None and truth.albedo:
         moving = [o.name for o in objects if o.motion is not None and not o.motion.is_static] + \
                  [vs.prefix for vs in view_sets if vs.motion is not None and not vs.motion.is_static]
