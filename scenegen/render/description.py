@@ -12,12 +12,10 @@ bitmaps, shapes, sensors) exist only in the device scene built from it.
 """
 from __future__ import annotations
 
-import copyreg
 import hashlib
 import json
 from dataclasses import dataclass, field
 from functools import cached_property
-from types import MappingProxyType
 
 import numpy as np
 import trimesh
@@ -26,14 +24,8 @@ from scenegen.assets import meshes, shapes
 from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.spec import model as m
 from scenegen.spec.assets_check import located
-from scenegen.spec.model.meta import frozen_mapping
 from scenegen.spec.serialize import spec_sha256
 from scenegen.spec.timeline import Timeline, is_animated, moves_within_frame
-
-# The spec's read-only mappings (scenegen.spec.model.meta.frozen_mapping, e.g. a texture's params)
-# travel in a description as a fresh read-only mapping of the same items.
-copyreg.pickle(MappingProxyType, lambda mp: (frozen_mapping, (dict(mp),)))
-
 
 @dataclass(frozen=True)
 class MeshPart:
