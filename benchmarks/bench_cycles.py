@@ -97,7 +97,7 @@ def main(argv=None) -> int:
     view = resolve_views(spec)[0]
     built = build_scene(spec, spp=args.spp, sampler="ldsampler", max_depth=args.max_depth)
     dr.set_thread_count(2)
-    render = lambda seed: render_view(built, "cam", view.cam_from_world, spp=args.spp, seed=seed)
+    render = lambda seed: render_view(built.device, "cam", view.cam_from_world, spp=args.spp, seed=seed)
     t = time.perf_counter()
     render(1)
     mi_cold = time.perf_counter() - t
@@ -233,7 +233,7 @@ def mitsuba_plan(spec, built, view, args, render) -> list[str]:
 
     def mi_render(b, sensor, spp):  # a sensor of ours: render_view sets its camera first
         if sensor is None:
-            return lambda: render_view(b, "cam", view.cam_from_world, spp=spp, seed=5)
+            return lambda: render_view(b.device, "cam", view.cam_from_world, spp=spp, seed=5)
         return lambda: np.array(mi.render(b.scene, sensor=sensor, spp=spp, seed=5))
 
     out = []

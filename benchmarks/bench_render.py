@@ -122,7 +122,7 @@ def main(argv=None) -> int:
     cam_name = views[0].camera
 
     def frame(v=views[1]):
-        render_view(built, cam_name, v.cam_from_world, spp=spec.render.spp, seed=1)
+        render_view(built.device, cam_name, v.cam_from_world, spp=spec.render.spp, seed=1)
         truth_pass(built.scene, built.cameras[cam_name], v.cam_from_world, built.id_tables)
 
     t_frame = best_of(frame, 3)
@@ -137,7 +137,7 @@ def main(argv=None) -> int:
     samples = []
     t0 = time.perf_counter()
     for i, v in enumerate(sv):
-        render_view(sb, v.camera, v.cam_from_world, spp=4, seed=i)
+        render_view(sb.device, v.camera, v.cam_from_world, spp=4, seed=i)
         truth_pass(sb.scene, sb.cameras[v.camera], v.cam_from_world, sb.id_tables)
         if i % 25 == 0 or i == len(sv) - 1:
             samples.append((i, rss_mb()))

@@ -23,7 +23,9 @@ RECON_EVAL_MAY_IMPORT = ("scenegen.geometry", "scenegen.dataset", "scenegen.erro
 #: Heavy or optional dependencies that may be imported inside a function (with a reason in a
 #: comment on the line or the line above): import cost or availability, never to dodge a cycle.
 LAZY_ALLOWED = ("cv2", "mitsuba", "drjit", "matplotlib", "dask", "distributed", "pycolmap", "trimesh", "rich",
-                "scipy", "scenegen.render.scene", "scenegen.render.raycast", "scenegen.render.drjit_ops")
+                "scipy",
+                "mujoco",  # the rigid-body engine: only a spec with `placement:` runs it (scenegen.physics)
+                "scenegen.render.scene", "scenegen.render.raycast", "scenegen.render.drjit_ops")
 #: The command line loads each command's implementation when the command runs, so that
 #: ``scenegen --help`` costs less than ``import numpy`` (docs/performance.md, "Start-up").
 LAZY_ALLOWED_IN = {"scenegen.cli": ("scenegen",)}
@@ -112,8 +114,12 @@ SCENEGEN_LAYERS = {
     "scenegen.assets": ("scenegen.geometry", "scenegen.quiet"),
     "scenegen.imaging": ("scenegen.geometry", "scenegen.dataset"),
     "scenegen.crossview": ("scenegen.geometry", "scenegen.dataset"),
+    # the rigid-body drop of `placement:`: arrays in, settled poses out (MuJoCo)
+    "scenegen.physics": ("scenegen.geometry",),
+    # a sensor kind (scenegen.spec.sensors) names what it writes in the dataset's terms (truth keys,
+    # a stream's schema and StreamWriter)
     "scenegen.spec": ("scenegen.errors", "scenegen.located_yaml", "scenegen.geometry", "scenegen.assets",
-                      "scenegen.imaging"),
+                      "scenegen.imaging", "scenegen.dataset", "scenegen.physics"),
     # the renderer implements the dataset's visibility rule (dataset.crossview.OCCLUSION_REL_TOL)
     # and casts the truth kinds the dataset stores (dataset.truth.TruthKind)
     "scenegen.render": ("scenegen.errors", "scenegen.geometry", "scenegen.assets", "scenegen.spec",

@@ -35,7 +35,7 @@ def render_linear(spec, view):
 
     built = build_scene(spec, spp=spec.render.spp, sampler=spec.render.sampler,
                         max_depth=spec.render.max_depth)
-    return render_view(built, view.camera, view.cam_from_world, spp=spec.render.spp,
+    return render_view(built.device, view.camera, view.cam_from_world, spp=spec.render.spp,
                        seed=view_seed(spec.render.seed, 0)), built.cameras[view.camera]
 
 

@@ -74,7 +74,8 @@ def render(text: str) -> np.ndarray:
     spec = parse_spec(text, base_dir=ROOT / "scenes")
     view = resolve_views(spec)[0]
     built = build_scene(spec, spp=spec.render.spp, sampler=spec.render.sampler, max_depth=spec.render.max_depth)
-    linear = render_view(built, view.camera, view.cam_from_world, spp=spec.render.spp, seed=1, motion=view.motion)
+    linear = render_view(built.device, view.camera, view.cam_from_world, spp=spec.render.spp, seed=1,
+                         motion=view.motion)
     return encode_image(linear, 8)
 
 

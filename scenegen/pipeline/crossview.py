@@ -48,7 +48,7 @@ from scenegen.geometry.seeds import hashed_seed32
 from scenegen.geometry.twoview import TwoView, plane_homography, plane_in_camera
 from scenegen.pipeline.pairs import select_pairs, stereo_frames, streams
 from scenegen.pipeline.stereo import write_stereo_frame
-from scenegen.pipeline.view import correspond_fn, rolling_rows, view_truth, visibility_fn
+from scenegen.pipeline.view import correspond_fn, rolling_rows, view_time, view_truth, visibility_fn, visible_at
 
 #: Spec geometry kinds that are planes in their object's z = 0 plane (normal +z): they get a
 #: homography per pair.
@@ -100,9 +100,9 @@ class CrossviewContext:
                                                  visibility_fn(self.built, v, rows), rows, correspond_fn(self.built, v))
         return self._geometry[name]
 
-    def at(self, name) -> None:
-        """Move a sequence's objects to the view's time (a static scene: nothing to do)."""
-        self.built.set_time(getattr(self.views[name], "time_s", None))
+    def time_s(self, name) -> float | None:
+        """The clock time of view ``name`` (None: a static spec's view)."""
+        return view_time(self.views[name])
 
     def object_pose(self, obj, name):
         """world_from_object of a spec object when view ``name`` was taken."""
@@ -166,15 +166,15 @@ def _pair(ctx: CrossviewContext, cfg, a: str, b: str) -> dict:
         root = ctx.sink.root
         pi, pj = sift_matches(read_png(root / view_paths(a)["image"]), read_png(root / view_paths(b)["image"]),
                               cfg.sift_ratio)
-        ctx.at(a)
         ga, gb = ctx.geometry(a), ctx.geometry(b)
         if ga.rolling is None and gb.rolling is None:
-            P = ctx.built.surface_points(cam_a, pose_a, pi)
+            P = ctx.built.surface_points(cam_a, pose_a, pi, time_s=ctx.time_s(a))
             c = gb.correspond(P.reshape(-1, 1, 3))
         else:  # each keypoint's surface point at its row's time, imaged by b's rows
             rows = ga.rolling
             P, ids = ctx.built.surface_hits(cam_a, pose_a, pi, rows=None if rows is None else rows.cam,
-                                              moves=rows.object_moves(pi[:, 1]) if rows and rows.objects else None)
+                                              moves=rows.object_moves(pi[:, 1]) if rows and rows.objects else None,
+                                              time_s=ctx.time_s(a))
             ids = np.zeros(len(pi), np.uint32) if ids is None else ids
             c = frame_motion(P.reshape(-1, 1, 3), ids.reshape(-1, 1), ga, gb, rows_a=pi[:, 1]).correspondence
         rows = label_real_matches(pi, pj, c.uv.reshape(-1, 2), c.state.ravel() == VISIBLE, cfg.sift_inlier_px)
@@ -235,13 +235,13 @@ def execute_crossview_item(ctx: CrossviewContext, item: tuple):
 def _board_views(ctx: CrossviewContext, name: str) -> str:
     """Every calibration board's truth in one view (a moving board moved with its object)."""
     cam, pose = ctx.camera(name)
-    ctx.at(name)
+    visible = visible_at(ctx.built, ctx.time_s(name))
     objects = {o.name: o for o in ctx.spec.objects}
     boards = {}
     for bname, (board, wfb) in ctx.built.boards.items():
         obj = objects[bname]
         wfb_v = ctx.object_pose(obj, name) @ obj.transform.world_from_object.inverse() @ wfb
-        boards[bname] = board_view_truth(board, wfb_v, cam, pose, ctx.built.visible_from, ctx.geometry(name),
+        boards[bname] = board_view_truth(board, wfb_v, cam, pose, visible, ctx.geometry(name),
                                          (obj.object_id, ctx.object_pose(obj, name)))
     ctx.write(view_targets_path(name), encode_json({"view": name, "boards": boards}))
     return name

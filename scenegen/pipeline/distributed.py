@@ -11,6 +11,10 @@ byte-identical to a serial run's, and a run killed at any point resumes like a s
 worker killed mid-write leaves a temporary file; the client removes those once every task is done.
 
 Workers must see the output folder at the same path (one machine, or a shared file system).
+A local cluster shares this machine's cores: each worker's Dr.Jit pool gets cores / workers
+threads (two processes with a pool of all cores each spent about 20 % more CPU on the same work,
+docs/performance.md), and Dask's own periodic work (event-loop ticks, monitors, the workers' stack
+sampler) is made rarer (:data:`LOCAL_CLUSTER_CONFIG`).
 Mitsuba is imported in a worker only through :func:`scenegen.render.load_scene`, which points
 Dr.Jit at a good libLLVM before ``import drjit``.
 """
@@ -26,15 +30,23 @@ from scenegen.dataset.files import remove_stale_temp_files
 from scenegen.dataset.view_files import write_view_files
 from scenegen.pipeline.view import render_view_data
 from scenegen.render import configure_llvm, load_scene
+from scenegen.render.threads import render_threads, set_render_threads
 from scenegen.spec import resolve_views
 
 __all__ = ["open_client", "render_views_dask", "render_frame_task", "worker_scene", "worker_stats", "note_stage_items",
-           "SCENES_KEPT"]
+           "SCENES_KEPT", "LOCAL_CLUSTER_CONFIG", "DRJIT_THREADS_ENV"]
 
 #: Loaded scenes a worker keeps (least recently used dropped first).
 SCENES_KEPT = 2
 _SCENES: "OrderedDict[tuple, tuple]" = OrderedDict()  # key -> (spec, views, built)
 _STATS = {"scene_loads": 0, "views_rendered": 0, "stage_items": 0}
+#: Dask settings of a local cluster: its defaults (20 ms event-loop ticks, a 100 ms memory monitor,
+#: a 10 ms stack sampler in each worker, for a dashboard we do not start) cost an idle 2-worker
+#: cluster 0.17 of a core, 0.025 with these (measured, docs/performance.md).
+LOCAL_CLUSTER_CONFIG = {"distributed.admin.tick.interval": "1s", "distributed.admin.system-monitor.interval": "1s",
+                        "distributed.worker.memory.monitor-interval": "1s", "distributed.worker.profile.enabled": False}
+#: Environment variable a local cluster's workers get: their Dr.Jit thread count.
+DRJIT_THREADS_ENV = "SCENEGEN_WORKER_DRJIT_THREADS"
 
 
 @contextlib.contextmanager
@@ -45,8 +57,8 @@ def open_client(*, workers: int | None = None, scheduler: str | None = None):
     if (workers is None) == (scheduler is None):
         raise ValueError("give exactly one of --workers N and --scheduler ADDRESS")
     try:
-        # Dask on use: a heavy dependency (~1 s to import) that only --workers/--scheduler need
-        from distributed import Client, LocalCluster
+        import dask  # Dask on use: a heavy dependency (~1 s to import) that only --workers/--scheduler need
+        from distributed import Client, LocalCluster  # its client and local cluster: the same reason
     except ImportError:  # fail only when the feature is used
         raise ValueError("--workers/--scheduler need Dask distributed: pip install 'dask[distributed]'") from None
     if scheduler is not None:
@@ -62,9 +74,12 @@ def open_client(*, workers: int | None = None, scheduler: str | None = None):
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     configure_llvm()  # spawned workers inherit DRJIT_LIBLLVM_PATH through the environment
-    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
-    client = Client(cluster)
+    threads = max(1, (os.cpu_count() or 1) // int(workers))  # the workers share this machine's cores
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the nannies hand it to (re)started workers
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR,
+                               env={DRJIT_THREADS_ENV: str(threads)})
+        client = Client(cluster)
     try:
         yield client
     finally:
@@ -81,6 +96,9 @@ def worker_scene(source, spp: int, variant: str):
         return hit
     spec = source.load()
     built = load_scene(spec, variant=variant, spp=spp)  # libLLVM path, then Mitsuba, the variant
+    threads = os.environ.get(DRJIT_THREADS_ENV)
+    if threads:  # a local cluster's worker: its share of the cores
+        set_render_threads(int(threads))
     _SCENES[key] = (spec, resolve_views(spec), built)
     _STATS["scene_loads"] += 1
     while len(_SCENES) > SCENES_KEPT:
@@ -111,9 +129,9 @@ def note_stage_items(n: int) -> None:
 
 
 def worker_stats() -> dict:
-    """This process's counters: scene_loads, views_rendered, stage_items, pid (run it with
-    ``client.run``)."""
-    return {**_STATS, "pid": os.getpid()}
+    """This process's counters: scene_loads, views_rendered, stage_items, pid, render_threads
+    (Dr.Jit's; None before a scene is loaded) (run it with ``client.run``)."""
+    return {**_STATS, "pid": os.getpid(), "render_threads": render_threads()}
 
 
 def render_views_dask(client, source, writer, pending, *, spp: int, seed: int, variant: str,

@@ -19,6 +19,7 @@ from scenegen.dataset.writer import DatasetWriter
 from scenegen.imaging.stage import imaging_record, raw_view_record
 from scenegen.pipeline.distributed import render_views_dask
 from scenegen.pipeline.progress import ViewProgress
+from scenegen.pipeline.sensors import write_streams
 from scenegen.pipeline.stages import run_stage
 from scenegen.pipeline.view import render_view_data, view_optics
 from scenegen.render import load_scene
@@ -161,6 +162,7 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
                     del image, linear, truth, extra  # the writer holds the only references
                     rendered += 1
                     bar.advance()
+    write_streams(spec, writer, built)  # the rig members that are not cameras, each by its sensor kind's writer
     for stage in ("crossview", "sequence"):  # cross-view truth, then truth across time (docs/crossview.md)
         run_stage(stage, spec, views, built, writer, spp=spp, seed=seed, variant=used.variant, client=dask_client,
                   source=source, progress=progress)

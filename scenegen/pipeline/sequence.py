@@ -5,8 +5,8 @@ camera stream both ways, point tracks, and for a stereo rig with rectified frame
 truth on the rectified left grid (:mod:`.stereo_sequence`).
 
 Truth points of frame a come from the truth pass at a's time in float64 (centre + range * ray,
-range from the float32 intersection); the scene is moved to b's time for b's visibility casts
-(:meth:`scenegen.render.scene.LoadedScene.set_time`). Only complete views take part; the index is
+range from the float32 intersection); b's visibility casts name b's time
+(:class:`scenegen.render.caster.Caster`). Only complete views take part; the index is
 written when every view is complete.
 """
 from __future__ import annotations

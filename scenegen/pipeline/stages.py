@@ -2,8 +2,10 @@
 rectified stereo frames, board views) and the sequence stage (motion pairs, point tracks, stereo
 motion pairs). The driver plans each stage's items (:func:`scenegen.pipeline.crossview.plan_crossview`,
 :func:`scenegen.pipeline.sequence.plan_sequence`); they run here one after the other, or on Dask
-workers in groups of consecutive items (a group shares its views' cached truth), each group's
-files written atomically by the worker and recorded by the driver in the plan's order. An item's
+workers in groups of items that share views (a group shares its views' cached truth and
+correspondences: a stage's ``locality`` puts them next to each other, and groups end where that
+key changes), each group's files written atomically by the worker and recorded by the driver, its
+index entries taken in the plan's order. An item's
 bytes do not depend on where it ran or with what else, so both ways give the same dataset
 (tests/scenegen/pipeline/test_stage_items_dask.py).
 
@@ -44,7 +46,10 @@ class Stage:
     """``plan(spec, views, is_complete, built) -> plan | None`` (``plan.items``);
     ``context(spec, complete views, built, sink, plan, spp, seed)``; ``execute(context, item) ->
     index entry``; ``finish(plan, entries, files, writer)``; ``label``: the progress line's;
-    ``prepare(spec, writer) -> {path: sha256}``: files the driver writes before the items."""
+    ``prepare(spec, writer) -> {path: sha256}``: files the driver writes before the items;
+    ``locality(item, position) -> key``: items with equal keys share cached work and run in one
+    group, groups taken in key order (``position``: a view name's index among the views); None:
+    the plan's own order is the one that shares most."""
 
     plan: Callable
     context: Callable
@@ -52,6 +57,7 @@ class Stage:
     finish: Callable
     label: str
     prepare: Callable = lambda spec, writer: {}
+    locality: Callable | None = None
 
 
 def _plan_crossview(spec, views, is_complete, built):
@@ -66,6 +72,13 @@ def _sequence_context(spec, views, built, sink, plan, spp, seed):
     return sequence.SequenceContext(spec, views, built, sink, keep_frames=plan.keep_frames)
 
 
+def _crossview_locality(item, position):
+    """A cross-view item's views, as their first and last position: a pair's, flow's and stereo
+    frame's items of the same two views share both views' truth points and correspondences."""
+    names = [n for n in item[1:] if n is not None]
+    return min(position[n] for n in names), max(position[n] for n in names)
+
+
 def _finish_sequence(plan, entries, files, writer):
     return sequence.finish_sequence(plan, files, writer)
 
@@ -77,7 +90,7 @@ def _prepare_sequence(spec, writer):
 
 STAGES = {
     "crossview": Stage(_plan_crossview, _crossview_context, crossview.execute_crossview_item,
-                       crossview.finish_crossview, "cross-view truth"),
+                       crossview.finish_crossview, "cross-view truth", locality=_crossview_locality),
     "sequence": Stage(lambda spec, views, is_complete, built: sequence.plan_sequence(spec, views, is_complete),
                       _sequence_context, sequence.execute_sequence_item, _finish_sequence, "sequence truth",
                       _prepare_sequence),
@@ -106,7 +119,8 @@ def run_stage(name: str, spec, views, built, writer, *, spp: int, seed: int, var
             files.update(sink.files)
         else:
             entries = _run_on_workers(name, plan, done, writer, files, client=client, source=source, spp=spp,
-                                      seed=seed, variant=variant, on_done=bar.advance)
+                                      seed=seed, variant=variant, on_done=bar.advance,
+                                      locality=stage.locality, position={v.name: k for k, v in enumerate(views)})
     return stage.finish(plan, entries, files, writer)
 
 
@@ -124,22 +138,40 @@ def stage_items_task(name: str, source, out_dir: str, done: tuple[str, ...], pla
     return entries, sink.files
 
 
-def _run_on_workers(name, plan, done, writer, files, *, client, source, spp, seed, variant, on_done):
+def item_groups(items, n_groups: int, keys=None) -> list[list[int]]:
+    """``items`` (their indices) cut into about ``n_groups`` groups of about equal size: in the
+    order of ``keys`` (one per item; None: the items' order), a group ending only where the key
+    changes (items with one key share cached work)."""
+    order = sorted(range(len(items)), key=lambda k: (keys[k], k)) if keys is not None else list(range(len(items)))
+    size = max(1, -(-len(items) // max(1, n_groups)))
+    groups, group = [], []
+    for pos, k in enumerate(order):
+        group.append(k)
+        last = pos + 1 == len(order)
+        if last or (len(group) >= size and (keys is None or keys[order[pos + 1]] != keys[k])):
+            groups.append(group)
+            group = []
+    return groups
+
+
+def _run_on_workers(name, plan, done, writer, files, *, client, source, spp, seed, variant, on_done, locality,
+                    position):
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
-    items = list(plan.items)
-    size = max(1, -(-len(items) // (GROUPS_PER_WORKER * n_workers)))
-    groups = [items[k:k + size] for k in range(0, len(items), size)]
+    items = plan.items
+    keys = None if locality is None else [locality(item, position) for item in items]
+    groups = item_groups(items, GROUPS_PER_WORKER * n_workers, keys)
     out_dir = str(Path(writer.root).resolve())
     names = tuple(v.name for v in done)
-    futures = [client.submit(stage_items_task, name, source, out_dir, names, plan, g, spp, seed, variant,
-                             pure=False) for g in groups]
-    entries = []
+    futures = [client.submit(stage_items_task, name, source, out_dir, names, plan, [items[k] for k in g], spp, seed,
+                             variant, pure=False) for g in groups]
+    entries = [None] * len(items)
     try:
-        for fut, group in zip(futures, groups):  # recorded in the plan's order
+        for fut, group in zip(futures, groups):
             group_entries, group_files = fut.result()
             writer.record_files(group_files)
             files.update(group_files)
-            entries += group_entries
+            for k, entry in zip(group, group_entries):  # the index lists them in the plan's order
+                entries[k] = entry
             for _ in group:
                 on_done()
     finally:

@@ -35,21 +35,21 @@ def write_stereo_frame(ctx, left: str, right: str, *, spp: int, seed: int) -> di
     rc = rect.camera
     built = ctx.built
     view_l = ctx.views[left]
-    ctx.at(left)  # a sequence's objects at the frame's time (both members share it)
+    time_s = ctx.time_s(left)  # a sequence's frame: its objects at its time (both members share it)
     truths = {}
     for side, pose in zip(STEREO_SIDES, (rect.cam_left_from_world, rect.cam_right_from_world)):
         lin = built.render_ideal(view_l.camera, rc, pose, spp=spp, seed=hashed_seed32(seed, left, side),
-                                 light_scales=view_l.light_scales)  # both sides: the left view's lighting
+                                 light_scales=view_l.light_scales, time_s=time_s)  # both: the left view's lighting
         ctx.write(stereo_path(left, "image", side), encode_png(srgb_image(lin, ctx.spec.render.bit_depth)))
         ctx.write(stereo_path(left, "linear", side), encode_exr(pack_channels("", lin, LINEAR_CHANNELS)))
-        t = built.truth(rc, pose)
+        t = built.truth(rc, pose, time_s=time_s)
         ctx.write(stereo_path(left, "ids", side), encode_exr(truth_id_channels(t)))
         truths[side] = (np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan),
                         t[TruthKind.DEPTH_Z])
     for side, other_pose in zip(STEREO_SIDES, (rect.cam_right_from_world, rect.cam_left_from_world)):
         pts, depth = truths[side]
         d = disparity_from_depth(depth, rect.f, rect.baseline_m)
-        c = correspond_points(built, pts, rc, other_pose)
+        c = correspond_points(built, pts, rc, other_pose, time_s)
         ctx.write(stereo_path(left, "disparity_pfm", side), encode_pfm(d))
         ctx.write(stereo_path(left, "disparity_occ", side), encode_kitti_disparity(d, np.isfinite(d)))
         ctx.write(stereo_path(left, "disparity_noc", side), encode_kitti_disparity(d, c.state == VISIBLE))

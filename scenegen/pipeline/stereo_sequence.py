@@ -21,7 +21,7 @@ from scenegen.dataset.sequence import StereoMotionTruth
 from scenegen.dataset.truth import TruthKind
 from scenegen.geometry.rectify import Rectification, rectify
 from scenegen.pipeline.pairs import streams
-from scenegen.pipeline.view import correspond_fn
+from scenegen.pipeline.view import correspond_fn, view_time
 
 
 def stereo_pairs(spec, views, complete: set, steps) -> list[tuple[int, tuple, tuple]]:
@@ -65,8 +65,7 @@ class StereoSequence:
         left = frame[0]
         if left.name not in self._frames:
             rect = self.rectification(frame)
-            self.built.set_time(getattr(left, "time_s", None))
-            t = self.built.truth(rect.camera, rect.cam_left_from_world)
+            t = self.built.truth(rect.camera, rect.cam_left_from_world, time_s=view_time(left))
             P = np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan)
             self._frames[left.name] = (rect, P, t[TruthKind.OBJECT_ID].copy())
             while len(self._frames) > self.keep_frames:

@@ -6,6 +6,9 @@ not depend on where it was made.
 """
 from __future__ import annotations
 
+import pickle
+from collections import OrderedDict
+
 import numpy as np
 
 from scenegen.crossview.correspondence import correspond
@@ -24,9 +27,10 @@ from scenegen.spec.light_truth import view_lights_document
 from scenegen.spec.timeline import poses_within_frame
 
 
-#: Rolling-shutter views whose row tables stay cached on the loaded scene (the render, the truth
-#: and the cross-view and sequence stages of a view ask for them in turn).
+#: Rolling-shutter row tables kept (the render, the truth and the cross-view and sequence stages
+#: of a view ask for them in turn), keyed by what they are made of (:func:`_rows_key`).
 ROWS_KEPT = 64
+_ROWS: OrderedDict = OrderedDict()
 
 
 def view_seed(seed: int, view_index: int) -> int:
@@ -47,20 +51,32 @@ def rolling_rows(built, view) -> RollingRows | None:
     return _rows(built, view)[1]
 
 
+def view_time(view) -> float | None:
+    """The clock time of a view: a sequence's frame time, None for a static spec's view."""
+    return getattr(view, "time_s", None)
+
+
+def _rows_key(built, view) -> tuple:
+    """What a view's row table is made of: the scene (its content hash: cameras, shutters and
+    timeline), the camera, its pose and motion, and the time; not the view's name."""
+    pose = view.cam_from_world.matrix.tobytes()
+    return (built.description.content_hash, view.camera, pose, pickle.dumps(view.motion), view_time(view))
+
+
 def _rows(built, view):
-    """(per-row cam_from_world or None, RollingRows or None) of a view, cached on the scene: the
+    """(per-row cam_from_world or None, RollingRows or None) of a view, cached by content: the
     truth pass's row poses are the table's nodes 0 .. H-1 themselves."""
     shutter = getattr(built.optics.get(view.camera), "shutter", None)
     camera_moves = view.motion is not None and not view.motion.is_static
     if shutter is None or shutter.rolling_readout_s == 0 or not (camera_moves or built.movers):
         return None, None  # a global shutter, or nothing moves: nothing to tabulate (or keep)
-    key = (view.name, getattr(view, "time_s", None))
-    cache = built.view_rows
+    key = _rows_key(built, view)
+    cache = _ROWS
     if key in cache:
         cache.move_to_end(key)
     else:
         H = built.cameras[view.camera].height
-        time_s = getattr(view, "time_s", None)
+        time_s = view_time(view)
         knots = [view.motion.knot_taus_s] if isinstance(view.motion, PathMotion) else []
         if built.movers and time_s is not None:
             knots.append(built.timeline.knot_times_s() - time_s)
@@ -87,28 +103,35 @@ def visibility_fn(built, view, rows: RollingRows | None):
     """The visibility cast of a frame (:class:`scenegen.crossview.frames.FrameGeometry`): in the
     scene at the view's time; with a rolling shutter's ``rows``, from each point's row centre
     with the moving objects where they are at that row's time (each ray cast at its own time)."""
+    time_s = view_time(view)
+
     def visible(centres, points, point_rows=None):
-        built.set_time(getattr(view, "time_s", None))
         moves = (rows.object_moves_at_times(rows.clock.times_s(point_rows))
                  if rows is not None and rows.objects else None)
-        return built.visible_from(centres, points, moves=moves)
+        return built.visible_from(centres, points, moves=moves, time_s=time_s)
     return visible
 
 
-def correspond_points(built, points_world, camera, cam_from_world):
-    """Correspondences of world points (H, W, 3) in a view of the loaded scene as it is: in one
-    kernel where it applies (:meth:`scenegen.render.scene.LoadedScene.correspond`), else
+def visible_at(built, time_s: float | None):
+    """``visible(centres, points)``: the visibility cast in the scene at ``time_s``."""
+    return lambda centres, points: built.visible_from(centres, points, time_s=time_s)
+
+
+def correspond_points(built, points_world, camera, cam_from_world, time_s: float | None = None):
+    """Correspondences of world points (H, W, 3) in a view of the scene at ``time_s``: in one
+    kernel where it applies (:meth:`scenegen.render.caster.Caster.correspond`), else
     :func:`scenegen.crossview.correspondence.correspond` with the visibility cast."""
     if built.kernel_correspondences:
-        return built.correspond(points_world, camera, cam_from_world)
-    return correspond(points_world, camera, cam_from_world, built.visible_from)
+        return built.correspond(points_world, camera, cam_from_world, time_s=time_s)
+    return correspond(points_world, camera, cam_from_world, visible_at(built, time_s))
 
 
 def correspond_fn(built, view):
     """A frame's correspondences of world points at the view's time (global shutter)."""
+    time_s = view_time(view)
+
     def corr(points, camera, cam_from_world):
-        built.set_time(getattr(view, "time_s", None))
-        return correspond_points(built, points, camera, cam_from_world)
+        return correspond_points(built, points, camera, cam_from_world, time_s)
     return corr
 
 
@@ -116,20 +139,18 @@ def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
     """The truth pass of a view: per-row poses for a rolling shutter (the camera's, and the moving
     objects' where each row's rays meet them at the row's time); range and depth_z in float64,
     or as the dataset stores them (float32, rounded in the kernel) with ``as_stored``. A
-    sequence's frame is cast at its time (the scene's objects moved there)."""
-    built.set_time(getattr(view, "time_s", None))
+    sequence's frame is cast at its time (the scene's objects there)."""
     rows = rolling_rows(built, view) if built.movers else None
     moves = rows.object_moves() if rows is not None and rows.objects else None
     return built.truth(built.cameras[view.camera], view.cam_from_world, row_poses=rolling_shutter_rows(built, view),
-                       as_stored=as_stored, row_moves=moves)
+                       as_stored=as_stored, row_moves=moves, time_s=view_time(view))
 
 
 def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
     :func:`scenegen.dataset.view_files.encode_view`; ``index`` is the view's position in the run."""
-    built.set_time(getattr(v, "time_s", None))  # a sequence's frame: its objects at its time
     linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
-                          light_scales=v.light_scales)
+                          light_scales=v.light_scales, time_s=view_time(v))  # a sequence's frame: at its time
     truth = view_truth(built, v, as_stored=True)
     params = spec.cameras[v.camera].imaging
     if params is None:  # clean path: sRGB encoding of the linear render
@@ -159,7 +180,8 @@ def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
                 or built.moving:
             raise ValueError(f"view {view.name!r}: albedo truth is for a still camera and a static scene "
                              "(no motion, no rolling shutter while moving)")
-        files[albedo_path(view.name)] = encode_albedo(built.albedo(built.cameras[view.camera], view.cam_from_world))
+        files[albedo_path(view.name)] = encode_albedo(built.albedo(built.cameras[view.camera], view.cam_from_world,
+                                                                   time_s=view_time(view)))
     if spec.truth.lights:
         files[lights_path(view.name)] = encode_json(view_lights_document(spec, view))
     if spec.truth.boxes:  # from the ids as stored and the meshes (docs/dataset_format.md, "Bounding boxes")

@@ -2,10 +2,14 @@
 
 The one way in is :func:`load_scene`: it picks a working libLLVM and the variant
 (:mod:`.backend`), imports Mitsuba, and loads a spec into a
-:class:`~scenegen.render.scene.LoadedScene`, whose methods render views, cast per-pixel truth and
-cast visibility rays. Modules: :mod:`.backend` (variant and libLLVM), :mod:`.sensor` (our camera
-model as a Mitsuba sensor, with :mod:`.drjit_ops`), :mod:`.materials`, :mod:`.objects`,
-:mod:`.lights` (one translation function per spec kind), :mod:`.scene` (loading),
+:class:`~scenegen.render.scene.LoadedScene`, a scene in three parts: its
+:class:`~scenegen.render.description.SceneDescription` (no Mitsuba; frozen, picklable, hashed),
+the :class:`~scenegen.render.device.DeviceScene` built from it (the only holder of Mitsuba
+handles) and the :class:`~scenegen.render.caster.Caster`'s renders, per-pixel truth and
+visibility casts, each with its camera, pose, time and lighting stated. Modules: :mod:`.backend`
+(variant and libLLVM), :mod:`.sensor` (our camera model as a Mitsuba sensor, with
+:mod:`.drjit_ops`), :mod:`.materials`, :mod:`.objects`, :mod:`.lights` (one translation function
+per spec kind), :mod:`.description`, :mod:`.device`, :mod:`.caster`, :mod:`.scene` (loading),
 :mod:`.frames` (renders), :mod:`.truth` (the truth pass), :mod:`.raycast` (visibility).
 
 Importing this package points Dr.Jit at a libLLVM >= 16 before anything imports it (Debian's

@@ -1,7 +1,7 @@
 """Objects that move over a sequence: placed at any time of the clock through
-:meth:`scenegen.render.scene.LoadedScene.set_time`, by rewriting their vertices (meshes) or their
-``to_world`` (the analytic sphere) from the placement at frame 0, in float64 numpy, uploaded
-as float32 like every mesh (:mod:`.objects`).
+:meth:`scenegen.render.device.DeviceScene.place_at` (each cast and render states its time), by
+rewriting their vertices (meshes) or their ``to_world`` (the analytic sphere) from the placement
+at frame 0, in float64 numpy, uploaded as float32 like every mesh (:mod:`.objects`).
 
 Where an object is at a time is the spec's answer (:class:`scenegen.spec.timeline.Timeline`), so
 the renders, the truth pass and the visibility casts of the sequence stage see the same

@@ -1,4 +1,4 @@
-"""Rendering images of a loaded scene: a view with its camera's lens and time effects, and the
+"""Rendering images of a device scene: a view with its camera's lens and time effects, and the
 ideal rectified renders of a stereo pair. Linear float32 RGB out; encoding is the pipeline's."""
 from __future__ import annotations
 
@@ -13,10 +13,12 @@ from scenegen.spec.model.render import effective_spp
 
 
 def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int,
-                motion=None, light_scales=None) -> np.ndarray:
-    """Linear float32 (H, W, 3) radiance of one view, with the camera's lens and time effects.
+                motion=None, light_scales=None, time_s: float | None = None) -> np.ndarray:
+    """Linear float32 (H, W, 3) radiance of one view of a device scene
+    (:class:`scenegen.render.device.DeviceScene`), with the camera's lens and time effects.
 
     ``cam_from_world`` is the mid-exposure pose; ``motion`` the camera's own velocities;
+    ``time_s`` the clock time of a sequence's frame (None: frame 0; its objects placed there);
     ``light_scales`` the factor on each spec light's power (:func:`set_lighting`; None = every
     light at its spec power, whatever an earlier view used). Moving objects are rendered in
     ``built.motion_subframes`` sub-frames, each with the objects at one time, and they are left
@@ -27,6 +29,8 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
     summed. Chromatic aberration renders each colour channel with its own camera.
     """
     set_lighting(built, light_scales)
+    built.place_at(time_s)
+    t_frame = built.time_or_rest(time_s)
     camera = built.cameras[camera_name]
     optics = built.optics.get(camera_name)
     sensor = built.sensors[camera_name]
@@ -44,7 +48,7 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
             tau = bins[k][2] if bins else ((k + 0.5) / n_sub - 0.5) * exposure
             place_moving_objects(built, tau)
             if built.animated:  # a sequence's objects follow their trajectories within the exposure
-                place_animated(built, built.time_s + tau)
+                place_animated(built, t_frame + tau)
         window = (0.0, 1.0) if bins else (k / n_sub, (k + 1) / n_sub)
         for c, cam in enumerate(channel_cameras):
             sensor.set_camera(cam, cam_from_world, optics, motion, time_window=window,
@@ -58,7 +62,7 @@ def render_view(built, camera_name: str, cam_from_world: Rigid3, *, spp: int, se
     if n_sub > 1:
         place_moving_objects(built, 0.0)
         if built.animated:
-            place_animated(built, built.time_s)
+            place_animated(built, t_frame)
     return (out if bins else out / n_sub).astype(np.float32)
 
 
@@ -78,10 +82,12 @@ def _time_bins(built, shutter, height: int) -> list[tuple[float, float, float]]:
 
 
 def render_ideal(built, sensor_camera_name: str, camera, cam_from_world: Rigid3, *, spp: int, seed: int,
-                 light_scales=None) -> np.ndarray:
+                 light_scales=None, time_s: float | None = None) -> np.ndarray:
     """Linear float32 (H, W, 3) of ``camera`` (a pinhole of the sensor's size, e.g. a rectified
-    view) through the sensor of ``sensor_camera_name``: no lens, motion or aberration."""
+    view) through the sensor of ``sensor_camera_name`` at clock time ``time_s`` (None: frame 0):
+    no lens, motion or aberration."""
     set_lighting(built, light_scales)
+    built.place_at(time_s)
     sensor = built.sensors[sensor_camera_name]
     sensor.set_camera(camera, cam_from_world)
     img = mi.render(built.scene, sensor=sensor, spp=effective_spp(built.sampler, int(spp)), seed=int(seed))

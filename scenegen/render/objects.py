@@ -1,8 +1,9 @@
-"""Spec objects -> Mitsuba shapes: world-frame triangle meshes (float32 on upload) and the
+"""Described objects -> Mitsuba shapes: world-frame triangle meshes (float32 on upload) and the
 analytic sphere (exact depth), plus the objects that move during the exposure.
 
-Geometry is placed in the world in float64 numpy (:func:`scenegen.assets.meshes.place`), so the
-dataset's world meshes and the rendered ones are the same triangles.
+Geometry is placed in the world in float64 numpy by the description
+(:func:`scenegen.render.description.describe_object`), so the dataset's world meshes and the
+rendered ones are the same triangles.
 """
 from __future__ import annotations
 
@@ -12,13 +13,11 @@ import mitsuba as mi
 import numpy as np
 import trimesh
 
-from scenegen.assets import meshes, shapes
-from scenegen.assets.libraries import mesh_within
-from scenegen.assets.mesh_materials import mesh_parts
 from scenegen.geometry.optics import world_from_object_at
 from scenegen.geometry.pose import Rigid3
 from scenegen.render.arrays import to_jit
 from scenegen.render.asset_materials import asset_bsdf, asset_emitter
+from scenegen.render.description import DescribedObject
 from scenegen.render.materials import board_material, is_alpha_masked, material_dict
 
 
@@ -61,74 +60,36 @@ def mitsuba_mesh(name: str, mesh: trimesh.Trimesh, bsdf: dict, smooth: bool, emi
     return mm
 
 
-def _sphere_entry(obj, bsdf: dict, built) -> dict:
-    s = np.asarray(obj.transform.scale)
-    if not np.allclose(s, s[0]):
-        raise ValueError(f"object {obj.name!r}: a sphere takes a uniform scale, got {tuple(s)}")
-    radius = obj.geometry.radius * float(s[0])
-    # the analytic sphere renders and is intersected exactly; the mesh is only exported
-    built.meshes_world[obj.name] = meshes.place(shapes.sphere(obj.geometry.radius), obj.transform)
+def _sphere_entry(obj, bsdf: dict) -> dict:
+    radius = obj.geometry.radius * float(np.asarray(obj.transform.scale)[0])  # uniform: describe_object
     T = np.eye(4)
     T[:3, :3] = obj.transform.world_from_object.R * radius  # keeps the texture's orientation
     T[:3, 3] = obj.transform.world_from_object.t
     return {"type": "sphere", "to_world": mi.ScalarTransform4f(T), "bsdf": bsdf}
 
 
-def object_entry(obj, built) -> dict:
-    """The Mitsuba dict entry (or shape) for one spec object; records its world mesh and board."""
+def object_entries(d: DescribedObject) -> tuple[dict, bool]:
+    """({key: Mitsuba dict entry or shape}, whether an entry has an alpha mask) of a described
+    object; a mesh rendered with its own materials gives one Mitsuba mesh per part,
+    ``{key_partNNN: mesh}`` (all parts carry the object's ids). Fresh Mitsuba objects per call."""
+    obj = d.spec
+    if d.parts:
+        out, alpha = {}, False
+        for p in d.parts:
+            am = p.material
+            bsdf = material_dict(obj.material) if am is None else asset_bsdf(am)
+            emitter = None if am is None else asset_emitter(am)
+            colors = None if am is None else am.vertex_colors
+            alpha |= is_alpha_masked(bsdf)
+            out[p.key] = mitsuba_mesh(p.name, p.mesh_world, bsdf, d.smooth, emitter, colors)
+        return out, alpha
     bsdf = material_dict(obj.material)
-    built.alpha_masked |= is_alpha_masked(bsdf)
-    if obj.geometry.kind == "sphere":
-        return _sphere_entry(obj, bsdf, built)
-    local, board = meshes.object_mesh(obj.geometry)
-    world = meshes.place(local, obj.transform)
-    built.meshes_world[obj.name] = world
-    if board is not None:
-        if not np.allclose(obj.transform.scale, 1.0):
-            raise ValueError(f"object {obj.name!r}: calibration targets cannot be scaled (their size is exact)")
-        built.boards[obj.name] = (board, obj.transform.world_from_object @ board.object_from_board())
-        bsdf = board_material(board)
-    return mitsuba_mesh(obj.name, world, bsdf, meshes.is_smooth(obj.geometry, local, world))
-
-
-def object_entries(obj, key: str, built) -> dict:
-    """The scene-dict entries of one spec object: ``{key: entry}``, or for a mesh rendered with
-    its own materials one Mitsuba mesh per part, ``{key_partNNN: mesh}`` (all parts carry the
-    object's ids). Records the world mesh, boards and whether any entry has an alpha mask."""
-    if obj.geometry.kind == "mesh" and obj.geometry.own_materials:
-        out = _own_material_parts(obj, key, built)
-    else:
-        out = {key: object_entry(obj, built)}
-    return out
-
-
-def _own_material_parts(obj, key: str, built) -> dict:
-    local, _ = meshes.object_mesh(obj.geometry)
-    world = meshes.place(local, obj.transform)
-    built.meshes_world[obj.name] = world
-    smooth = meshes.is_smooth(obj.geometry, local, world)
-    parts = mesh_parts(obj.geometry.path, mesh_within(obj.geometry))
-    if sum(p.vertex_count for p in parts) != len(world.vertices) or \
-            sum(p.face_count for p in parts) != len(world.faces):
-        raise ValueError(f"object {obj.name!r}: the parts of {obj.geometry.path_as_written!r} do not "
-                         "add up to the loaded mesh")
-    normals = np.asarray(world.vertex_normals) if smooth else None
-    out = {}
-    for i, p in enumerate(parts):
-        vs, fs = slice(p.vertex_start, p.vertex_start + p.vertex_count), slice(p.face_start, p.face_start + p.face_count)
-        sub = trimesh.Trimesh(vertices=world.vertices[vs], faces=world.faces[fs] - p.vertex_start, process=False)
-        if normals is not None:
-            sub.vertex_normals = normals[vs]
-        if p.uv is not None:
-            sub.visual = trimesh.visual.TextureVisuals(uv=p.uv)
-        am = p.material
-        bsdf = material_dict(obj.material) if am is None else asset_bsdf(am)
-        emitter = None if am is None else asset_emitter(am)
-        colors = None if am is None else am.vertex_colors
-        built.alpha_masked |= is_alpha_masked(bsdf)
-        built.part_meshes[f"{key}_part{i:03d}"] = sub
-        out[f"{key}_part{i:03d}"] = mitsuba_mesh(f"{obj.name}/part{i:03d}", sub, bsdf, smooth, emitter, colors)
-    return out
+    alpha = is_alpha_masked(bsdf)
+    if d.is_sphere:
+        return {d.key: _sphere_entry(obj, bsdf)}, alpha
+    if d.board is not None:
+        bsdf = board_material(d.board[0])
+    return {d.key: mitsuba_mesh(obj.name, d.mesh_world, bsdf, d.smooth)}, alpha
 
 
 def placed_geometry(entry, mesh_world) -> dict:

@@ -17,7 +17,7 @@ Each ray carries a time (seconds on the sequence clock, :mod:`scenegen.geometry.
 :func:`timed_first_hit_at_times` places the movers at every ray's own time; a rolling-shutter
 row, a LiDAR beam, an event are all just times.
 
-Built on first use (:meth:`scenegen.render.scene.LoadedScene.timed`): scenes without a rolling
+Built on first use (:meth:`scenegen.render.device.DeviceScene.timed`): scenes without a rolling
 shutter and a moving object never pay for it.
 """
 from __future__ import annotations

@@ -18,6 +18,7 @@ from types import MappingProxyType
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec import model as m
 from scenegen.spec.model.meta import spec_meta
+from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.views import resolve_views
 
 #: Version of the layout returned by spec_to_dict.
@@ -77,6 +78,19 @@ def _plain(x):
     return x
 
 
+def rig_to_dict(rig: m.Rig) -> dict:
+    """A rig as plain data, each member's sensor and pose under its kind's keys (a camera's
+    ``camera`` and ``rig_from_cam``, as datasets have always held them)."""
+    d = _plain(rig)
+    d["members"] = []
+    for mb in rig.members:
+        member = _plain(mb)
+        sensor_key, pose_key = SENSOR_KINDS[mb.kind].member_keys
+        member[sensor_key], member[pose_key] = member.pop("sensor"), member.pop("rig_from_sensor")
+        d["members"].append(member)
+    return d
+
+
 def spec_to_dict(spec: m.SceneSpec) -> dict:
     """The resolved spec: every default filled in, references replaced by what they name, every
     view's pose computed. JSON-able; stable key order."""
@@ -106,16 +120,19 @@ def spec_to_dict(spec: m.SceneSpec) -> dict:
         "objects": objects,
         "lights": _plain(spec.lights),
         "cameras": cameras,
-        "rigs": _plain(spec.rigs),
+        "rigs": {str(name): rig_to_dict(r) for name, r in spec.rigs.items()},
         "view_sets": _view_sets(spec.view_sets),
         "views": views,
         # only when declared, so that specs without variation keep their hashes
+        # only when declared: sensors of the kinds other than cameras
+        **({"sensors": _plain(spec.sensors)} if spec.sensors else {}),
         **({"variation": _plain(spec.variation)} if spec.variation is not None else {}),
         # likewise the cross-view outputs: their settings are part of the run's identity
         **({"crossview": _plain(spec.crossview)} if getattr(spec, "crossview", None) is not None else {}),
         **({"variant": _plain(dict(spec.variant))} if spec.variant is not None else {}),
         **({"sequence": _plain(spec.sequence)} if getattr(spec, "sequence", None) is not None else {}),
         **({"truth": _plain(spec.truth)} if getattr(spec, "truth", None) is not None else {}),
+        **({"placement": _plain(spec.placement)} if getattr(spec, "placement", None) is not None else {}),
     }
 
 

@@ -25,6 +25,7 @@ from scenegen.spec.load import parse_spec
 from scenegen.spec.parse.fields import plain_value, write_fields
 from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.optics import OPTICS_KEYS
+from scenegen.spec.sensors import SENSOR_KINDS, section_kinds
 from scenegen.spec.serialize import spec_to_dict
 
 
@@ -188,9 +189,13 @@ def _rig(r: m.Rig) -> dict:
         left, right = r.members
         return {"type": "stereo", "left": left.camera, "right": right.camera, "baseline_m": r.baseline_m,
                 "vergence_deg": r.vergence_deg}
-    return {"type": "multi", "members": [{"camera": mb.camera, "name": mb.name,
-                                          "rig_from_cam": [[float(v) for v in row] for row in mb.rig_from_cam.matrix]}
-                                         for mb in r.members]}
+    return {"type": "multi", "members": [_member(mb) for mb in r.members]}
+
+
+def _member(mb: m.RigMember) -> dict:
+    sensor_key, pose_key = SENSOR_KINDS[mb.kind].member_keys  # a camera's: camera, rig_from_cam
+    return {"kind": mb.kind, sensor_key: mb.sensor, "name": mb.name,
+            pose_key: [[float(v) for v in row] for row in mb.rig_from_sensor.matrix], "time_offset_s": mb.time_offset_s}
 
 
 def _placement(p, frame: str) -> tuple[str, Any]:
@@ -255,6 +260,15 @@ def _variation(v) -> dict:
     return d
 
 
+def _placement_section(p: m.DropPlacement) -> dict:
+    """The drop with its settled poses (4x4 rows, bit-exact): parsed back without the engine."""
+    d: dict[str, Any] = {"type": p.type, "objects": list(p.objects), **write_fields(p)}
+    if p.region_min is not None:
+        d["region"] = {"min": _v(p.region_min), "max": _v(p.region_max)}
+    d["poses"] = {name: _pose_rows(pose) for name, pose in p.poses.items()}
+    return d
+
+
 def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
     """The spec as the plain data its YAML holds (every value explicit)."""
     if spec.variant is not None:
@@ -267,10 +281,18 @@ def spec_to_yaml_dict(spec: m.SceneSpec) -> dict:
         d["materials"] = {k: _material(v) for k, v in spec.materials.items()}
     if spec.objects:
         d["objects"] = [_object(o, spec.materials) for o in spec.objects]
+    if spec.placement is not None:  # a dropped object's pose is the recorded one: its scale only
+        for o in d["objects"]:
+            if o["name"] in spec.placement.poses:
+                o["transform"] = {"scale": o["transform"]["scale"]}
+        d["placement"] = _placement_section(spec.placement)
     if spec.lights:
         d["lights"] = [_light(li) for li in spec.lights]
     if spec.cameras:
         d["cameras"] = {k: _camera(c) for k, c in spec.cameras.items()}
+    for kind in section_kinds():  # the other sensor kinds' sections, before the rigs naming them
+        if sensors := kind.sensors_of(spec):
+            d[kind.section] = {k: kind.to_yaml(v) for k, v in sensors.items()}
     if spec.rigs:
         d["rigs"] = {k: _rig(r) for k, r in spec.rigs.items()}
     if spec.view_sets:

@@ -22,6 +22,7 @@ from scenegen.errors import SpecError
 from scenegen.geometry.optics import Motion, PathMotion
 from scenegen.geometry.pose import Rigid3, look_at
 from scenegen.spec import model as m
+from scenegen.spec.sensors import SENSOR_KINDS, VIEWS, RigFrame
 
 #: Random eyes closer than this to the target, or looking (nearly) along up, are redrawn.
 _MIN_SEPARATION_M = 1e-6
@@ -50,7 +51,7 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                                     time_s=time_s))
             else:
                 rig = spec.rigs[vs.rig]
-                for member in rig.members:
+                for member in view_members(rig):
                     world_from_cam = world_from_x @ member.rig_from_cam
                     views.append(m.View(
                         name=f"{vs.prefix}_{member.name}_{frame:0{width}d}", camera=member.camera,
@@ -60,6 +61,26 @@ def resolve_views(spec: m.SceneSpec) -> tuple[m.View, ...]:
                         time_s=time_s))
             frame += 1
     return tuple(views)
+
+
+def view_members(rig: m.Rig) -> tuple[m.RigMember, ...]:
+    """The members of a rig that make views (of a kind that produces views: its cameras)."""
+    return tuple(mb for mb in rig.members if SENSOR_KINDS[mb.kind].produces == VIEWS)
+
+
+def rig_frames(spec: m.SceneSpec) -> tuple[tuple[m.ViewSet, tuple[RigFrame, ...]], ...]:
+    """Every rig view set with its frames (a rig at a time), in view set order; frame indices
+    and times as :func:`resolve_views` gives the views of those frames."""
+    out, frame = [], 0
+    for set_index, vs in enumerate(spec.view_sets):
+        poses = placement_poses(vs)
+        times = vs.placement.times_s if isinstance(vs.placement, m.TrajectoryPath) else (None,) * len(poses)
+        if vs.rig is not None:
+            out.append((vs, tuple(RigFrame(rig=vs.rig, view_set=set_index, frame_index=frame + k,
+                                           time_s=None if t is None else float(t), world_from_rig=pose)
+                                  for k, (pose, t) in enumerate(zip(poses, times)))))
+        frame += len(poses)
+    return tuple(out)
 
 
 def view_set_light_scales(spec: m.SceneSpec, vs: m.ViewSet) -> tuple[float, ...] | None:
@@ -171,7 +192,7 @@ def path_motion(spec: m.SceneSpec, vs: m.ViewSet, time_s: float):
     the trajectory itself (:class:`scenegen.geometry.optics.PathMotion`; the renderer and the
     per-row truth sample the same curve). None when no camera of the view set has a shutter with
     an exposure or a readout time (nothing would use it)."""
-    cams = [vs.camera] if vs.camera is not None else [mb.camera for mb in spec.rigs[vs.rig].members]
+    cams = [vs.camera] if vs.camera is not None else [mb.camera for mb in view_members(spec.rigs[vs.rig])]
     if not any(_timed(spec, c) for c in cams):
         return None
     return PathMotion(trajectory=vs.placement.trajectory.trajectory(), time_s=float(time_s))

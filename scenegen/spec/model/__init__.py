@@ -21,7 +21,8 @@ Camera models are the registry's (:data:`scenegen.geometry.camera.MODELS`), bit 
 Modules, by idea: :mod:`.meta` (field metadata), :mod:`.render`, :mod:`.materials`,
 :mod:`.geometry` (shapes, meshes, targets, transforms, objects), :mod:`.lights`, :mod:`.cameras`
 (cameras, rigs), :mod:`.views` (view sets, views), :mod:`.crossview`, :mod:`.variation`,
-:mod:`.timeline` (sequence clock, trajectories, joints, tracks), :mod:`.scene` (SceneSpec). This package re-exports them all.
+:mod:`.timeline` (sequence clock, trajectories, joints, tracks), :mod:`.placement` (objects
+dropped by a rigid-body simulation), :mod:`.scene` (SceneSpec). This package re-exports them all.
 """
 from scenegen.spec.model import imaging as _imaging  # noqa: F401 (describes the imaging records)
 from scenegen.spec.model.cameras import RIG_TYPES, CameraSpec, Rig, RigMember
@@ -43,6 +44,7 @@ from scenegen.spec.model.materials import (
 from scenegen.spec.model.meta import (
     ID_MAX, SEED_MAX, WORLD_UP, FieldInfo, Meta, field_info, frozen_mapping, spec_fields,
 )
+from scenegen.spec.model.placement import DROP_ORIENTATIONS, PLACEMENT_TYPES, DropPlacement
 from scenegen.spec.model.render import RENDER_VARIANTS, SAMPLERS, RenderSettings, effective_spp
 from scenegen.spec.model.scene import SceneSpec
 from scenegen.spec.model.timeline import (
@@ -71,6 +73,7 @@ __all__ = [
     "AssetFile",
     "ID_MAX", "SEED_MAX", "WORLD_UP", "FieldInfo", "Meta", "field_info", "frozen_mapping",
     "spec_fields",
+    "DROP_ORIENTATIONS", "PLACEMENT_TYPES", "DropPlacement",
     "RENDER_VARIANTS", "SAMPLERS", "RenderSettings", "effective_spp",
     "SceneSpec",
     "Animation", "JointKeyframe", "JointSpec", "Keyframe", "SequenceSpec", "TrackSpec",

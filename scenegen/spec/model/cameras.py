@@ -72,10 +72,32 @@ class CameraSpec:
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class RigMember:
+    """A sensor in a rig: of kind ``kind`` (a key of :data:`scenegen.spec.sensors.SENSOR_KINDS`),
+    named ``sensor`` in that kind's section, at ``rig_from_sensor`` in the rig frame, sampling at
+    the rig's time plus ``time_offset_s``. ``camera`` and ``rig_from_cam`` read a camera member."""
+
     name: str = param(unit="member name", derived="'left'/'right' for stereo; for multi the "
-                                                  "camera name")
-    camera: str  # a key of `cameras:`
-    rig_from_cam: Rigid3 = part(unit="camera pose in the rig frame (metres)")
+                                                  "sensor name")
+    sensor: str  # a key of its kind's section (`cameras:` for a camera)
+    rig_from_sensor: Rigid3 = part(unit="sensor pose in the rig frame (metres)")
+    kind: str = param("camera", unit="sensor kind (scenegen.spec.sensors.SENSOR_KINDS)",
+                      omit_default=True)
+    time_offset_s: float = param(0.0, unit="seconds, added to the rig's time", omit_default=True)
+
+    @property
+    def camera(self) -> str:
+        """The camera of a camera member (a key of `cameras:`)."""
+        return self._camera_member().sensor
+
+    @property
+    def rig_from_cam(self) -> Rigid3:
+        """A camera member's pose in the rig frame."""
+        return self._camera_member().rig_from_sensor
+
+    def _camera_member(self) -> "RigMember":
+        if self.kind != "camera":
+            raise AttributeError(f"rig member {self.name!r} is a {self.kind}, not a camera")
+        return self
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)

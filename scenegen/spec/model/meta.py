@@ -12,6 +12,7 @@ their metadata with :func:`describe_foreign`, their defaults staying where they 
 """
 from __future__ import annotations
 
+import copyreg
 import dataclasses
 import functools
 import types
@@ -116,6 +117,11 @@ def where_field():
 def frozen_mapping(d: Mapping | None = None) -> Mapping:
     """A read-only view of a dict (insertion order kept)."""
     return types.MappingProxyType(dict(d or {}))
+
+
+# A spec pickles (a Dask worker, a SceneDescription): its read-only mappings travel as a fresh
+# read-only mapping of the same items (MappingProxyType itself refuses pickling).
+copyreg.pickle(types.MappingProxyType, lambda mp: (frozen_mapping, (dict(mp),)))
 
 
 _FOREIGN: dict[type, dict[str, Meta]] = {}

@@ -10,6 +10,7 @@ from scenegen.spec.model.crossview import CrossviewSpec
 from scenegen.spec.model.geometry import SceneObject
 from scenegen.spec.model.lights import Light
 from scenegen.spec.model.materials import Material
+from scenegen.spec.model.placement import DropPlacement
 from scenegen.spec.model.meta import SEED_MAX, frozen_mapping, param, part
 from scenegen.spec.model.render import RenderSettings
 from scenegen.spec.model.truth import TruthSpec
@@ -29,6 +30,9 @@ class SceneSpec:
     lights: tuple[Light, ...] = part((), unit="the `lights:` list")
     cameras: Mapping[str, CameraSpec] = part(default_factory=frozen_mapping, unit="by name")
     rigs: Mapping[str, Rig] = part(default_factory=frozen_mapping, unit="by name")
+    sensors: Mapping[str, Mapping[str, Any]] = part(default_factory=frozen_mapping, unit="the sensors of "
+                                                    "the kinds other than cameras (scenegen.spec.sensors), "
+                                                    "by kind, then by name")
     view_sets: tuple[ViewSet, ...] = part((), unit="the `views:` list")
     file: str | None = part(None, unit="the spec file as named by the user ('<string>' for text)")
     base_dir: Path = part(default_factory=Path.cwd, unit="directory relative paths resolve "
@@ -42,6 +46,9 @@ class SceneSpec:
                                     "sequence; None = a static scene")
     truth: TruthSpec | None = part(None, unit="per-view truth written on request (albedo, "
                                              "lights); None = none", omit_default=True)
+    placement: DropPlacement | None = part(None, unit="objects dropped onto a support and settled "
+                                                     "(their settled poses recorded); None = none",
+                                                omit_default=True)
     variant: Mapping[str, Any] | None = part(None, unit="a derived variant's index, seed and "
                                                         "drawn values "
                                                         "(scenegen.spec.variants.derive_variant); "

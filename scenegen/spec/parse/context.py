@@ -35,6 +35,7 @@ class ParseContext:
     render: RenderSettings | None = None  # set after `render:`
     materials: Mapping[str, Material] = field(default_factory=frozen_mapping)
     cameras: Mapping[str, CameraSpec] = field(default_factory=frozen_mapping)
+    sensors: Mapping[str, Mapping] = field(default_factory=frozen_mapping)  # other sensor kinds' sections
     rigs: Mapping[str, Rig] = field(default_factory=frozen_mapping)
     objects: tuple[SceneObject, ...] = ()
     lights: tuple[Light, ...] = ()

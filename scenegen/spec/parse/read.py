@@ -104,17 +104,6 @@ def read_enum(f: Fields, cls: type, name: str, key: str | None = None, *,
     return dflt if node is None else node.as_enum(choices or fi.meta.choices, fi.meta.shown)
 
 
-def read_bool(f: Fields, cls: type, name: str, key: str | None = None) -> bool:
-    fi, dflt = info(cls, name)
-    node = value_node(f, key or name, fi)
-    return dflt if node is None else node.as_bool()
-
-
-def read_color(node: Node, cls: type, name: str, unit: str | None = None):
-    """A grey value or 3 numbers >= 0 (the field's unit)."""
-    return node.as_color(unit or field_info(cls, name).meta.shown)
-
-
 def seed_or_none(f: Fields, cls: type, name: str = "seed", key: str | None = None) -> int | None:
     """An explicit seed, or None (then the caller derives one)."""
     return read_int(f, cls, name, key, default=None)

@@ -6,18 +6,21 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
+from scenegen.dataset.layout import check_name
 from scenegen.errors import SpecError
 from scenegen.located_yaml import Document, Fields, Node
 from scenegen.spec.finite import check_finite
 from scenegen.spec.model.limits import MAX_VIEWS
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.model.scene import SceneSpec
+from scenegen.spec.model.views import TrajectoryPath
 from scenegen.spec.parse.cameras import parse_camera
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.crossview import check_pair_views, parse_crossview
 from scenegen.spec.parse.lights import parse_light
 from scenegen.spec.parse.materials import parse_material
 from scenegen.spec.parse.objects import parse_object
+from scenegen.spec.parse.placement import check_variation, parse_placement
 from scenegen.spec.parse.read import read_int
 from scenegen.spec.parse.render import parse_render
 from scenegen.spec.parse.rigs import parse_rig
@@ -25,10 +28,11 @@ from scenegen.spec.parse.timeline import check_sequence, parse_sequence
 from scenegen.spec.parse.truth import parse_truth
 from scenegen.spec.parse.variation import parse_variation
 from scenegen.spec.parse.views import parse_view_set
-from scenegen.spec.views import resolve_views
+from scenegen.spec.sensors import SENSOR_KINDS, STREAM, section_kinds, stream_name
+from scenegen.spec.views import resolve_views, view_members
 
 TOP_LEVEL_KEYS = ("name", "description", "seed", "render", "materials", "objects", "lights",
-                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth")
+                  "cameras", "rigs", "views", "crossview", "variation", "sequence", "truth", "placement")
 #: Scene name of spec text that comes from no file.
 TEXT_SCENE_NAME = "scene"
 
@@ -41,7 +45,7 @@ def parse_document(doc: Document) -> SceneSpec:
                         f"{', '.join(TOP_LEVEL_KEYS)}), got an empty document",
                         file=doc.file, line=1)
     f = root.as_mapping("a mapping at the top level (keys: name, objects, cameras, views, ...)")
-    f.check(optional=TOP_LEVEL_KEYS)
+    f.check(optional=TOP_LEVEL_KEYS + tuple(k.section for k in section_kinds()))
     default_name = TEXT_SCENE_NAME if doc.file.startswith("<") else Path(doc.file).stem
     name = f.get("name").as_name("a scene name") if "name" in f else default_name
     description = (f.get("description").as_str() if "description" in f
@@ -51,6 +55,8 @@ def parse_document(doc: Document) -> SceneSpec:
     ctx = ctx.but(render=parse_render(f.get("render"), ctx))
     ctx = ctx.but(materials=frozen_mapping(named_section(f, "materials", parse_material, ctx)))
     ctx = ctx.but(cameras=frozen_mapping(named_section(f, "cameras", parse_camera, ctx)))
+    ctx = ctx.but(sensors=frozen_mapping({k.name: frozen_mapping(named_section(f, k.section, k.parse, ctx))
+                                          for k in section_kinds() if k.section in f}))  # other sensor kinds
     ctx = ctx.but(rigs=frozen_mapping(named_section(f, "rigs", parse_rig, ctx)))
     sequence = parse_sequence(f.get("sequence"), ctx) if "sequence" in f else None
     check_finite(sequence)  # the clock before the views and objects timed by it: named at its source
@@ -60,21 +66,28 @@ def parse_document(doc: Document) -> SceneSpec:
         objects.append(parse_object(item, i, ctx.but(objects=tuple(objects))))
     unique_names(f.get("objects"), objects, "object")
     ctx = ctx.but(objects=tuple(objects))
+    placement = None
+    if "placement" in f:  # the dropped objects at their settled poses from here on
+        placement, placed = parse_placement(f.get("placement"), f.get("objects"), ctx)
+        ctx = ctx.but(objects=placed)
     lights = list_section(f, "lights", parse_light, ctx)
     unique_names(f.get("lights"), lights, "light")
     ctx = ctx.but(lights=tuple(lights))  # named by view sets' `lights:`
     view_sets = list_section(f, "views", parse_view_set, ctx)
     check_view_count(f.get("views"), view_sets, ctx.rigs)  # before any pose is made
+    check_stream_members(f.get("views"), view_sets, ctx.rigs)
     crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
     truth = parse_truth(f.get("truth"), ctx) if "truth" in f else None
+    if placement is not None:
+        check_variation(placement, variation, ctx.objects)
     spec = SceneSpec(
         name=name, description=description, seed=ctx.scene_seed, render=ctx.render,
         materials=ctx.materials, objects=ctx.objects, lights=ctx.lights, cameras=ctx.cameras,
-        rigs=ctx.rigs, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
+        rigs=ctx.rigs, sensors=ctx.sensors, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
         warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
-        truth=truth)
+        truth=truth, placement=placement)
     if truth is not None and truth.albedo:
         moving = [o.name for o in objects if o.motion is not None and not o.motion.is_static] + \
                  [vs.prefix for vs in view_sets if vs.motion is not None and not vs.motion.is_static]
@@ -129,8 +142,30 @@ def planned_views(vs) -> int:
     return n
 
 
+def check_stream_members(node, view_sets, rigs) -> None:
+    """A rig member of a stream kind samples at its frames' times, so its view set needs them (a
+    ``trajectory:`` placement), and its stream ``<view set>_<member>`` needs a name of its own."""
+    seen: dict[str, int] = {}
+    for i, (item, vs) in enumerate(zip(node.items() if view_sets else [], view_sets)):
+        for mb in rigs[vs.rig].members if vs.rig is not None else ():
+            if SENSOR_KINDS[mb.kind].produces != STREAM:
+                continue
+            if not isinstance(vs.placement, TrajectoryPath):
+                raise item.error(f"rig {vs.rig!r} holds the {mb.kind} {mb.name!r}, whose stream samples over "
+                                 "time: its view set needs times (a `trajectory:` placement)")
+            name = stream_name(vs, mb)
+            try:
+                check_name("stream", name)
+            except ValueError as e:
+                raise item.error(str(e)) from None
+            if name in seen:
+                raise item.error(f"stream {name!r} is made by views[{seen[name]}] too; give the view sets "
+                                 "distinct `name`s")
+            seen[name] = i
+
+
 def check_view_count(node, view_sets, rigs) -> None:
-    total = sum(planned_views(vs) * (len(rigs[vs.rig].members) if vs.rig is not None else 1)
+    total = sum(planned_views(vs) * (len(view_members(rigs[vs.rig])) if vs.rig is not None else 1)
                 for vs in view_sets)
     if total > MAX_VIEWS:
         raise node.error(f"the view sets make {total:,} views; at most {MAX_VIEWS:,} per run (MAX_VIEWS, "

@@ -206,6 +206,8 @@ def test_dask_workers_match_serial_run_and_load_each_scene_once(tmp_path):
     assert sum(st["views_rendered"] for st in stats) == 8
     assert all(st["scene_loads"] <= 1 for st in stats)  # kept, not reloaded per frame
     assert all(st["pid"] != os.getpid() for st in stats)  # rendered in worker processes
+    # each local worker's Dr.Jit pool is its share of the cores (the serial run's is all of them)
+    assert all(st["render_threads"] == max(1, os.cpu_count() // 2) for st in stats if st["views_rendered"])
 
 
 # --- kill and resume ----------------------------------------------------------------------------

@@ -56,7 +56,7 @@ views:
     built = build_scene(spec, spp=16, sampler="ldsampler", max_depth=2)
     errs = []
     for view, d in zip(resolve_views(spec), DIRECTIONS):
-        rgb = render_view(built, "cam", view.cam_from_world, spp=16, seed=0)[2, 2].astype(np.float64)
+        rgb = render_view(built.device, "cam", view.cam_from_world, spp=16, seed=0)[2, 2].astype(np.float64)
         got = 2 * rgb - 1
         want = np.asarray(d, np.float64) / np.linalg.norm(d)
         errs.append(np.degrees(np.arccos(np.clip(got @ want / np.linalg.norm(got), -1, 1))))

@@ -110,7 +110,7 @@ def _render(built, scales, seed=7):
     from scenegen.render.frames import render_view
 
     spec, views, b = built
-    return render_view(b, "cam", views[0].cam_from_world, spp=16, seed=seed, light_scales=scales)
+    return render_view(b.device, "cam", views[0].cam_from_world, spp=16, seed=seed, light_scales=scales)
 
 
 @pytest.mark.render
@@ -154,7 +154,7 @@ views:
 """, file=str(tmp_path / "s.yaml"), base_dir=tmp_path)
     b = build_scene(spec, spp=8, sampler="ldsampler", max_depth=2)
     pose = resolve_views(spec)[0].cam_from_world
-    r = lambda k: render_view(b, "cam", pose, spp=8, seed=1, light_scales=k)
+    r = lambda k: render_view(b.device, "cam", pose, spp=8, seed=1, light_scales=k)
     for one, two in (((1.0, 0.0), (2.0, 0.0)), ((0.0, 1.0), (0.0, 2.0))):
         a = r(one)
         assert a.max() > 0.05, one
@@ -205,9 +205,9 @@ def test_light_off_is_as_if_absent(tmp_path):
     b = build_scene(spec, spp=16, sampler="ldsampler", max_depth=3)
     for on in (0, 2):  # only the bulb; only the sky
         alone = parse_spec(base + lights[on])
-        expected = render_view(build_scene(alone, spp=16, sampler="ldsampler", max_depth=3), "cam", pose,
+        expected = render_view(build_scene(alone, spp=16, sampler="ldsampler", max_depth=3).device, "cam", pose,
                                spp=16, seed=1)
-        got = render_view(b, "cam", pose, spp=16, seed=1, light_scales=tuple(float(i == on) for i in range(3)))
+        got = render_view(b.device, "cam", pose, spp=16, seed=1, light_scales=tuple(float(i == on) for i in range(3)))
         assert expected.max() > 0.01 and np.array_equal(got, expected), on
 
 
@@ -219,10 +219,10 @@ def test_state_restored_whatever_came_before(built):
 
     spec, views, b = built
     fresh = build_scene(spec, spp=16, sampler="ldsampler", max_depth=3)
-    a = render_view(fresh, "cam", views[0].cam_from_world, spp=16, seed=3)
+    a = render_view(fresh.device, "cam", views[0].cam_from_world, spp=16, seed=3)
     _render(built, (0.0, 2.0, 0.25))
     _render(built, (2.0, 0.0, 0.0))
-    again = render_view(b, "cam", views[0].cam_from_world, spp=16, seed=3)
+    again = render_view(b.device, "cam", views[0].cam_from_world, spp=16, seed=3)
     assert b.light_scales == (1.0, 1.0, 1.0)
     assert np.array_equal(a, again)
 

@@ -70,7 +70,7 @@ def test_defocus_blur_radius_follows_thin_lens(mi, depth_m):
 
     spec, views, built = _build(STEP_SPEC.replace("DEPTH", str(depth_m)), spp=256)
     cam, optics = built.cameras["cam"], built.optics["cam"]
-    img = render_view(built, "cam", views[0].cam_from_world, spp=256, seed=3).mean(axis=2)
+    img = render_view(built.device, "cam", views[0].cam_from_world, spp=256, seed=3).mean(axis=2)
     profile = img[20:100].mean(axis=0)  # (W,) averaged over rows
     profile = (profile - profile[:10].mean()) / (profile[-10:].mean() - profile[:10].mean())
     lsf = np.diff(profile)  # line-spread function at u + 0.5
@@ -145,7 +145,7 @@ def test_rolling_shutter_corners_match_per_row_truth(mi):
     cam = built.cameras["cam"]
     board, world_from_board = built.boards["board"]
     shutter = built.optics["cam"].shutter
-    img = render_view(built, "cam", view.cam_from_world, spp=64, seed=1, motion=view.motion)
+    img = render_view(built.device, "cam", view.cam_from_world, spp=64, seed=1, motion=view.motion)
     detected = _corners(img.mean(axis=2))
     pts = world_from_board.apply(board.points_board)
 
@@ -189,7 +189,7 @@ def test_chromatic_aberration_moves_each_channel_as_configured(mi):
     view = views[0]
     board, world_from_board = built.boards["board"]
     cams = built.optics["cam"].chromatic_aberration.channel_cameras(built.cameras["cam"])
-    img = render_view(built, "cam", view.cam_from_world, spp=64, seed=1)
+    img = render_view(built.device, "cam", view.cam_from_world, spp=64, seed=1)
     pts_cam = view.cam_from_world.apply(world_from_board.apply(board.points_board))
     green = cams[1].project(pts_cam)
     for c in (0, 1, 2):
@@ -243,7 +243,7 @@ def test_motion_blur_streak_is_centred_at_mid_exposure(mi, who):
     view = views[0]
     cam = built.cameras["cam"]
     mid = cam.project(view.cam_from_world.apply([[0.0, 0.0, 0.0]]))[0]
-    img = render_view(built, "cam", view.cam_from_world, spp=256, seed=2, motion=view.motion).mean(axis=2)
+    img = render_view(built.device, "cam", view.cam_from_world, spp=256, seed=2, motion=view.motion).mean(axis=2)
     prof = img.sum(axis=0)
     cols = np.arange(len(prof))
     centroid_u = (prof * cols).sum() / prof.sum()

@@ -227,7 +227,7 @@ def test_chessboard_corners_detected_at_truth(mi):
     board, world_from_board = built.boards["board"]
     cam = built.cameras["cam"]
     for view in resolve_views(spec):
-        linear = render_view(built, "cam", view.cam_from_world, spp=64, seed=1)
+        linear = render_view(built.device, "cam", view.cam_from_world, spp=64, seed=1)
         grey = cv2.cvtColor(encode_image(linear, 8), cv2.COLOR_RGB2GRAY)
         found, corners = cv2.findChessboardCorners(grey, (9, 6))
         assert found
@@ -268,7 +268,8 @@ views:
       - {eye: [0, 0, 0], target: [1, 0, 0.3]}
 """, file=str(tmp_path / "env.yaml"), base_dir=tmp_path)
     built = build_scene(spec, spp=16, sampler="ldsampler", max_depth=2)
-    up, down, horizon = (render_view(built, "cam", v.cam_from_world, spp=16, seed=0) for v in resolve_views(spec))
+    up, down, horizon = (render_view(built.device, "cam", v.cam_from_world, spp=16, seed=0)
+                         for v in resolve_views(spec))
     np.testing.assert_allclose(up.mean(axis=(0, 1)), (0.1, 0.2, 0.9), atol=0.02)
     np.testing.assert_allclose(down.mean(axis=(0, 1)), (0.8, 0.3, 0.1), atol=0.02)
     # looking 17 degrees above the horizon: sky in the whole view (fov 30 deg horizontally)

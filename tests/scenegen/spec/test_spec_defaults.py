@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import sys
 from dataclasses import MISSING
 from pathlib import Path
 from types import MappingProxyType
@@ -22,6 +23,10 @@ from scenegen.spec import model as m
 from scenegen.spec import parse_spec, reference
 from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_fields
 from scenegen.spec.parse.read import read_float
+from scenegen.spec.sensors import SENSOR_KINDS
+
+sys.path.insert(0, str(Path(__file__).parent))
+from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
 
 ROOT = Path(__file__).resolve().parents[3]
 PARSE_DIR = ROOT / "scenegen" / "spec" / "parse"
@@ -58,6 +63,9 @@ S = lambda i: (lambda s: s.objects[0].geometry)  # noqa: E731
 SEQ = "sequence: {fps: 10, frames: 3}\n"
 JOINT = ("objects:\n  - {name: a, shape: box}\n  - {name: b, shape: box, parent: a, joint: {type: "
          "revolute, axis: [0, 0, 1], keyframes: [{time_s: 0, angle_deg: 0}]}}\n")
+#: A drop with its poses recorded: parsed without the engine.
+DROP = ("objects:\n  - {name: t, shape: box}\n  - {name: s, shape: sphere}\n"
+        "placement: {type: drop, onto: t, objects: [s], poses: {s: {translation: [0, 0, 1]}}}\n")
 CASES = [
     *[(m.RenderSettings, k, "render: {}\n", lambda s, k=k: getattr(s.render, k), v)
       for k, v in (("spp", 16), ("max_depth", 3), ("seed", 5), ("variant", "scalar_rgb"),
@@ -176,8 +184,23 @@ CASES = [
      lambda s: s.view_sets[0].placement.trajectory.interpolation, "linear"),
     *[(m.JointSpec, k, SEQ + JOINT, lambda s, k=k: getattr(s.objects[1].animation.joint, k), v)
       for k, v in (("origin", (0.1, 0.0, 0.0)), ("interpolation", "linear"))],
+    *[(m.DropPlacement, k, DROP, lambda s, k=k: getattr(s.placement, k), v)
+      for k, v in (("drop_height_m", 0.2), ("orientation", "yaw"), ("friction", 0.5), ("settle_s", 2.0),
+                   ("rest_speed_m_s", 0.01))],
+]
+#: A camera and a clock of one name: a member naming it is either, as its kind says.
+CLK = "cameras:\n  clk: {size: [64, 48], fx: 50}\nclocks:\n  clk: {}\nrigs:\n  r: {type: multi, members: [%s]}\n"
+CASES += [
+    (m.RigMember, "kind", CLK % "{sensor: clk}", lambda s: s.rigs["r"].members[0].kind, "clock"),
+    (m.RigMember, "time_offset_s", CLK % "{kind: clock, sensor: clk}",
+     lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
 ]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
+
+
+@pytest.fixture(autouse=True)
+def clock_kind(monkeypatch):
+    monkeypatch.setitem(SENSOR_KINDS, CLOCK.name, CLOCK)
 
 
 def parse(text, tmp_path):
