@@ -71,7 +71,7 @@ views:
     look_at: [{{eye: [0, 0, 0], target: {DIRECTION.tolist()}, up: [0, 0, 1]}}]
 """, file=str(tmp_path / "sky.yaml"), base_dir=tmp_path)
         built = build_scene(spec, spp=4, sampler="ldsampler", max_depth=2)
-        rgb = render_view(built, "cam", resolve_views(spec)[0].cam_from_world, spp=4, seed=0)
+        rgb = render_view(built.device, "cam", resolve_views(spec)[0].cam_from_world, spp=4, seed=0)
         lum = rgb.mean(axis=2)
         row, col = np.unravel_index(np.argmax(lum), lum.shape)
         centres[rot] = (col, row, lum.max())
