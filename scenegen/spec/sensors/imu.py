@@ -121,7 +121,11 @@ FIELDS = (
 def write_imu(run: SensorRun) -> None:
     """The member's samples (module docstring), in chunks of DEFAULT_CHUNK_SAMPLES."""
     imu, member = run.sensor, run.member
-    traj = run.spec.view_sets[run.frames[0].view_set].placement.trajectory.trajectory()
+    traj_spec = run.spec.view_sets[run.frames[0].view_set].placement.trajectory
+    if traj_spec.interpolation != "spline":  # the spec check refuses this; a spec built in Python may not have run it
+        raise SpecError.at(traj_spec.where, f"the IMU {member.name!r} needs a C2 trajectory (interpolation: spline), "
+                           f"got {traj_spec.interpolation!r}")
+    traj = traj_spec.trajectory()
     world_from_imu = Composed(traj, StaticTrajectory(member.rig_from_sensor))
     stamps, times = imu_sample_times([f.time_s for f in run.frames], member.time_offset_s, imu.rate_hz,
                                      traj.times_s)

@@ -49,7 +49,7 @@ def test_the_imu_stream_is_written_verified_and_read_back(rendered):
     assert (s.kind, s.sensor, s.samples) == ("imu", "imu0", 41)  # 0 .. 0.2 s at 200 Hz
     assert sorted(f.name for f in s.schema.fields) == sorted(IMU.truth)  # stream.json keeps them sorted
     stamps, t = s.field("stamp_s"), s.time_s
-    assert np.allclose(stamps, np.arange(41) / 200.0, atol=1e-15) and np.array_equal(t, stamps + 0.002)
+    assert np.allclose(stamps, np.arange(41) / 200.0, atol=1e-15) and np.array_equal(t, stamps + 0.005)
     # the truth is the rig's trajectory with the member's extrinsic, evaluated independently here
     spec = load_spec(spec_path)
     member = spec.rigs["r"].members[1]
@@ -60,6 +60,14 @@ def test_the_imu_stream_is_written_verified_and_read_back(rendered):
     assert np.array_equal(s.field("gyro_true_rad_s"), truth.angular_velocity_rad_s)
     assert np.array_equal(s.field("position_m"), truth.t)
     assert np.allclose(matrix_from_quat_wxyz(s.field("quat_wxyz")), truth.R, atol=1e-15)
+    # the extrinsic as truth: where a sample is taken at a frame's time (stamped 0.095 s, taken at
+    # 0.1 s), the IMU is the camera's pose (the camera sits at the rig origin) times rig_from_imu
+    k = int(np.argmin(np.abs(t - 0.1)))
+    assert abs(t[k] - 0.1) < 1e-15
+    _, cam_from_world = d.camera("seq_left_0001")
+    world_from_imu_k = cam_from_world.inverse() @ member.rig_from_sensor
+    assert np.allclose(s.field("position_m")[k], world_from_imu_k.t, atol=1e-12)
+    assert np.allclose(matrix_from_quat_wxyz(s.field("quat_wxyz")[k]), world_from_imu_k.R, atol=1e-12)
     # measured = true + bias + white, the bias starting at 0; the white part has the configured
     # discrete sigma (the gyroscope's 0.001 rad/s/sqrt(Hz) over sqrt(1/200 s): 0.0141 rad/s)
     white = s.field("gyro_rad_s") - s.field("gyro_true_rad_s") - s.field("gyro_bias_rad_s")

@@ -30,7 +30,7 @@ rigs:
     type: multi
     members:
       - {camera: cam, name: left}
-      - {kind: imu, sensor: imu0, name: imu, rig_from_sensor: {translation: [0.05, 0.01, -0.02], rotation_deg: [90, 0, 0]}, time_offset_s: 0.002}
+      - {kind: imu, sensor: imu0, name: imu, rig_from_sensor: {translation: [0.05, 0.01, -0.02], rotation_deg: [90, 0, 0]}, time_offset_s: 0.005}
 views:
   - rig: r
     name: seq
@@ -62,7 +62,7 @@ def test_an_imu_is_read_with_its_preset_its_overrides_and_its_member(tmp_path):
     assert imu.accelerometer_random_walk == 3.0e-3 and imu.gyroscope_random_walk == 1.9393e-5
     assert imu.gyroscope_noise_density == 0.001  # the explicit value over the preset's 1.6968e-4
     member = spec.rigs["r"].members[1]
-    assert (member.kind, member.sensor, member.time_offset_s) == ("imu", "imu0", 0.002)
+    assert (member.kind, member.sensor, member.time_offset_s) == ("imu", "imu0", 0.005)
     assert np.allclose(member.rig_from_sensor.t, [0.05, 0.01, -0.02])
     # the default seed is derived from the scene seed and the field path, and differs per IMU
     two = parse(VIO.replace("imus:\n", "imus:\n  imu1: {}\n"), tmp_path)
@@ -99,7 +99,7 @@ LINEAR = VIO.replace("interpolation: spline", "interpolation: linear")
      "gyroscope_noise_density: expected a value >= 0 (rad/s/sqrt(Hz)), got -1"),
     (VIO.replace("preset: euroc_adis16448", "rate_hz: 0"), 10, "rate_hz: expected a value > 0 and <= 100000 (Hz), got 0"),
     (VIO.replace("preset: euroc_adis16448", "bias: 1"), 10, "unknown key 'bias'"),
-    (VIO.replace("time_offset_s: 0.002", "time_offset_s: 0.5"), 21,
+    (VIO.replace("time_offset_s: 0.005", "time_offset_s: 0.5"), 21,
      "fewer than 2 samples fall within the trajectory's keyframes [0, 0.3] s"),
     (VIO.replace("{fps: 10, frames: 3}", "{fps: 0.0001, frames: 2}").replace("time_s: 0.3", "time_s: 20000"), 21,
      "would take 2,000,001 samples at 200 Hz"),
