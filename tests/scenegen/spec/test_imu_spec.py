@@ -3,6 +3,8 @@ explicit noise values, rig members with an extrinsic and a time offset, the roun
 times, and bad input as one-line errors (exit 2 from the CLI)."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -10,8 +12,9 @@ from scenegen import cli
 from scenegen.errors import SpecError
 from scenegen.geometry.imu import NOISE_PRESETS
 from scenegen.spec import parse_spec, same_spec, spec_sha256, spec_to_dict, to_yaml
-from scenegen.spec.sensors import SENSOR_KINDS
+from scenegen.spec.sensors import SENSOR_KINDS, SensorRun
 from scenegen.spec.sensors.imu import IMU, imu_sample_times
+from scenegen.spec.views import rig_frames
 
 #: A camera and an IMU in a rig on a 0.3 s spline, three frames at 10 Hz (line numbers matter).
 VIO = """\
@@ -116,3 +119,18 @@ def test_the_cli_refuses_a_linear_trajectory_under_an_imu_with_exit_2(tmp_path, 
     assert cli.main(["validate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "vio.yaml:21:" in err and "interpolation" in err and "Traceback" not in err
+
+
+def test_the_writer_refuses_a_linear_trajectory_the_parser_did_not_see(tmp_path):
+    """A spec changed after parsing (or built in Python) still gets no IMU off a linear path."""
+    spec = parse(VIO, tmp_path)
+    vs = spec.view_sets[0]
+    linear = dataclasses.replace(vs.placement.trajectory, interpolation="linear")
+    spec = dataclasses.replace(spec, view_sets=(dataclasses.replace(
+        vs, placement=dataclasses.replace(vs.placement, trajectory=linear)),))
+    ((_, frames),) = rig_frames(spec)
+    member = spec.rigs["r"].members[1]
+    run = SensorRun(spec=spec, member=member, sensor=spec.sensors["imu"]["imu0"], frames=frames,
+                    stream="seq_imu", writer=None)
+    with pytest.raises(SpecError, match="needs a C2 trajectory \\(interpolation: spline\\), got 'linear'"):
+        IMU.write(run)
