@@ -12,6 +12,10 @@ Internal conventions (used everywhere in scenegen and recon_eval):
   centre (``range``). ``range = depth_z * |(x, y, 1)|`` for the z = 1 ray (x, y, 1).
 * Quaternions are (w, x, y, z), scalar first (COLMAP's order).
 * Texture UVs: u along texture columns, v along rows with v = 0 at the top row (image row 0).
+* World: right-handed, +z up (``WORLD_UP`` of the spec's look-ats). Gravity is
+  ``GRAVITY_WORLD_MPS2 = (0, 0, -9.80665)`` m/s^2 (standard gravity, pointing down), and an
+  accelerometer measures the specific force ``f_body = R_world_from_body^T (a_world - g_world)``:
+  at rest with +z up it reads (0, 0, +9.80665) (:mod:`scenegen.geometry.imu`).
 
 Foreign conventions, one function (or constant) each:
 
@@ -44,6 +48,8 @@ from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.rotation import matrix_from_quat_wxyz, quat_wxyz_from_matrix
 
 # --- camera axes -----------------------------------------------------------------------------
+#: Gravity in the Z-up world frame, m/s^2 (standard gravity, 9.80665, CGPM 1901).
+GRAVITY_WORLD_MPS2 = np.array([0.0, 0.0, -9.80665])
 #: x_mitsuba_cam = MITSUBA_FROM_OPENCV_CAM @ x_opencv_cam (x left, y up, z forward).
 MITSUBA_FROM_OPENCV_CAM = np.diag([-1.0, -1.0, 1.0])
 #: x_opengl_cam = OPENGL_FROM_OPENCV_CAM @ x_opencv_cam (x right, y up, z backward).

@@ -75,7 +75,7 @@ def parse_document(doc: Document) -> SceneSpec:
     ctx = ctx.but(lights=tuple(lights))  # named by view sets' `lights:`
     view_sets = list_section(f, "views", parse_view_set, ctx)
     check_view_count(f.get("views"), view_sets, ctx.rigs)  # before any pose is made
-    check_stream_members(f.get("views"), view_sets, ctx.rigs)
+    check_stream_members(f.get("views"), view_sets, ctx.rigs, ctx.sensors)
     crossview, pair_views = parse_crossview(f.get("crossview"), ctx) if "crossview" in f \
         else (None, ())
     variation = parse_variation(f.get("variation"), ctx) if "variation" in f else None
@@ -142,9 +142,10 @@ def planned_views(vs) -> int:
     return n
 
 
-def check_stream_members(node, view_sets, rigs) -> None:
+def check_stream_members(node, view_sets, rigs, sensors=None) -> None:
     """A rig member of a stream kind samples at its frames' times, so its view set needs them (a
-    ``trajectory:`` placement), and its stream ``<view set>_<member>`` needs a name of its own."""
+    ``trajectory:`` placement), and its stream ``<view set>_<member>`` needs a name of its own;
+    then the kind's own rules on the view set (``SensorKind.check_view_set``)."""
     seen: dict[str, int] = {}
     for i, (item, vs) in enumerate(zip(node.items() if view_sets else [], view_sets)):
         for mb in rigs[vs.rig].members if vs.rig is not None else ():
@@ -153,6 +154,9 @@ def check_stream_members(node, view_sets, rigs) -> None:
             if not isinstance(vs.placement, TrajectoryPath):
                 raise item.error(f"rig {vs.rig!r} holds the {mb.kind} {mb.name!r}, whose stream samples over "
                                  "time: its view set needs times (a `trajectory:` placement)")
+            kind = SENSOR_KINDS[mb.kind]
+            if kind.check_view_set is not None:
+                kind.check_view_set(mb, (sensors or {}).get(mb.kind, {})[mb.sensor], vs, item)
             name = stream_name(vs, mb)
             try:
                 check_name("stream", name)

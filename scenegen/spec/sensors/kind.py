@@ -78,7 +78,9 @@ class SensorKind:
     STREAM; ``truth``: what each output holds (the camera: the per-pixel truth keys; a stream:
     its field names). ``write(run: SensorRun)``: a stream kind's writer (None for views, which
     the pipeline renders). ``to_yaml(model) -> dict``: one sensor back to YAML (the camera's is
-    ``scenegen.spec.to_yaml``'s own)."""
+    ``scenegen.spec.to_yaml``'s own). ``check_view_set(member, sensor, view_set, node)``: a stream
+    kind's rules on the view set its rig is placed by (``node`` its YAML node), raising a
+    SpecError (e.g. the IMU's: a C2 trajectory); None = no rules beyond having times."""
 
     name: str
     section: str
@@ -91,6 +93,7 @@ class SensorKind:
     time_offsets: bool = True
     write: Callable[[SensorRun], Any] | None = None
     to_yaml: Callable[[Any], dict] | None = None
+    check_view_set: Callable[..., None] | None = None
 
     def __post_init__(self):
         if self.produces not in PRODUCTS:

@@ -4,11 +4,13 @@ each member's output through it."""
 from __future__ import annotations
 
 from scenegen.spec.sensors.camera import CAMERA
+from scenegen.spec.sensors.imu import IMU
 from scenegen.spec.sensors.kind import SensorKind
 
 #: Sensor kind name -> SensorKind (a rig member's default kind: RigMember.kind, the camera).
 SENSOR_KINDS: dict[str, SensorKind] = {
     CAMERA.name: CAMERA,
+    IMU.name: IMU,
 }
 
 

@@ -24,6 +24,7 @@ from scenegen.spec import parse_spec, reference
 from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_fields
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
+from scenegen.spec.sensors.imu import ImuSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -194,6 +195,7 @@ CASES += [
     (m.RigMember, "kind", CLK % "{sensor: clk}", lambda s: s.rigs["r"].members[0].kind, "clock"),
     (m.RigMember, "time_offset_s", CLK % "{kind: clock, sensor: clk}",
      lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
+    (ImuSpec, "rate_hz", "imus:\n  imu0: {}\n", lambda s: s.sensors["imu"]["imu0"].rate_hz, 100.0),
 ]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
