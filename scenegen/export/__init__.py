@@ -19,7 +19,9 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``kitti-sceneflow``: KITTI 2015 scene flow layout (disp_*_0, disp_*_1, flow_* on the rectified
   left grid, obj_map, calib) from a stereo rig's sequence;
 * ``sintel``: MPI-Sintel layout (final/, flow/, occlusions/, invalid/, depth/, camdata_left/) per
-  camera stream of a sequence of pinhole cameras.
+  camera stream of a sequence of pinhole cameras;
+* ``euroc``: EuRoC MAV ``mav0/`` (camN images and data.csv, imu0, state_groundtruth_estimate0,
+  sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU.
 """
 from __future__ import annotations
 
@@ -27,6 +29,7 @@ from pathlib import Path
 
 from scenegen.export import (
     colmap,
+    euroc,
     gaussian_splatting,
     kitti_flow,
     kitti_sceneflow,
@@ -47,12 +50,14 @@ from scenegen.export.errors import ExportError
 FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.export, "nerf": nerf.export,
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
-           "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export}
+           "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
+           "euroc": euroc.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
-                  "kitti-sceneflow": "stereo frame pairs", "sintel": "views"}
+                  "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
+                  "euroc": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:
