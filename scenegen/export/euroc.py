@@ -76,4 +76,4 @@ def export(ds, dest, progress=None) -> dict:
         write(dest, rel, data)
     return {"files": files + 2 + len(calib), "rig": rig.rig, "imu_stream": s.name, "imu_samples": s.samples,
             "cameras": {f"cam{k}": c.member for k, c in enumerate(rig.cameras)},
-            "frames": len(rig.cameras[0].views), "timeshift_cam_imu_s": -rig.time_offset_s}
+            "frames": len(rig.cameras[0].views), "timeshift_cam_imu_s": 0.0 - rig.time_offset_s}

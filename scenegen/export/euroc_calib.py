@@ -102,7 +102,7 @@ def camchain_yaml(rig, root: str) -> bytes:
         if k:
             prev_from_imu = rig.cameras[k - 1].imu_from_cam.inverse()
             out.append("  T_cn_cnm1:\n" + _matrix_rows((cam_from_imu @ prev_from_imu.inverse()).matrix, "  "))
-        out.append(f"  timeshift_cam_imu: {fmt(-rig.time_offset_s)}\n")
+        out.append(f"  timeshift_cam_imu: {fmt(0.0 - rig.time_offset_s)}\n")
     return "".join(out).encode()
 
 

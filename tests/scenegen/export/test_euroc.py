@@ -1,0 +1,151 @@
+"""The EuRoC MAV export (scenegen.export.euroc) read back by a reader written here from the
+formats' documentation (EuRoC's ASL dataset format: csv + sensor.yaml; Kalibr's wiki, "YAML
+formats"), with csv, PyYAML and SciPy's rotations, not our code: a two-camera rig with a
+distorting camera and an IMU, 32x24, three frames; and the refusals."""
+from __future__ import annotations
+
+import csv
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.spatial.transform import Rotation
+
+from scenegen.cli import main
+from scenegen.dataset import Dataset
+from scenegen.export.errors import ExportError
+from scenegen.export.euroc_calib import radtan_parameters
+from scenegen.geometry.camera import Camera
+from scenegen.pipeline.run import render_spec
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "spec"))
+from test_imu_spec import VIO  # noqa: E402
+
+#: VIO with a distorting camera (k1 k2 p1 p2), a second camera 0.1 m to the right and the IMU's
+#: clock in step with the rig's (so a ground-truth row lies at every frame's time).
+STEREO_VIO = (VIO.replace("cam: {size: [32, 24], fx: 30}",
+                          "cam: {size: [32, 24], fx: 30, fy: 31, cx: 15.2, cy: 11.7, model: opencv, "
+                          "dist: [-0.05, 0.01, 0.001, -0.002]}")
+              .replace("      - {camera: cam, name: left}\n",
+                       "      - {camera: cam, name: left}\n"
+                       "      - {camera: cam, name: right, rig_from_cam: {translation: [0.1, 0, 0], "
+                       "rotation_deg: [0, 2, 0]}}\n")
+              .replace(", time_offset_s: 0.005}", "}"))
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    root = tmp_path_factory.mktemp("euroc")
+    spec = root / "vio.yaml"
+    spec.write_text(STEREO_VIO)
+    render_spec(spec, root / "out", progress=False)
+    assert main(["export", str(root / "out"), "--format", "euroc", "-o", str(root / "euroc")]) == 0
+    return root / "out", root / "euroc"
+
+
+def read_csv(path: Path) -> tuple[list[str], list[list[str]]]:
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def matrix(rows) -> np.ndarray:
+    return np.asarray(rows, dtype=np.float64).reshape(4, 4)
+
+
+def pose(R, t) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, t
+    return T
+
+
+@pytest.mark.render
+def test_the_euroc_export_reads_back_as_the_dataset(exported):
+    out, dest = exported
+    cams = json.loads((out / "cameras.json").read_text())
+    stream = Dataset(out).streams["seq_imu"]
+    mav = dest / "mav0"
+    assert sorted(p.name for p in mav.iterdir()) == ["cam0", "cam1", "imu0", "state_groundtruth_estimate0"]
+    # the ground truth: body (= IMU) pose in the world per timestamp
+    head, rows = read_csv(mav / "state_groundtruth_estimate0" / "data.csv")
+    assert head[0] == "#timestamp" and head[1].strip() == "p_RS_R_x [m]" and head[4].strip() == "q_RS_w []"
+    assert len(head) == 17 and head[16].strip() == "b_a_RS_S_z [m s^-2]"
+    world_from_body = {int(r[0]): pose(Rotation.from_quat([float(x) for x in r[5:8]] + [float(r[4])]).as_matrix(),
+                                       [float(x) for x in r[1:4]]) for r in rows}
+    assert len(rows) == stream.samples == 41
+    chain = yaml.safe_load((dest / "camchain.yaml").read_text())
+    for k, member in enumerate(("left", "right")):
+        views = [v for v in cams["view_order"] if cams["views"][v]["rig_member"] == member]
+        head, rows = read_csv(mav / f"cam{k}" / "data.csv")
+        assert head == ["#timestamp [ns]", "filename"]
+        stamps = [int(r[0]) for r in rows]
+        assert stamps == [round(cams["views"][v]["time_s"] * 1e9) for v in views] == [0, 100_000_000, 200_000_000]
+        assert [r[1] for r in rows] == [f"{s}.png" for s in stamps]
+        assert all((mav / f"cam{k}" / "data" / r[1]).is_file() for r in rows)
+        assert len(list((mav / f"cam{k}" / "data").iterdir())) == len(views)
+        sensor = yaml.safe_load((mav / f"cam{k}" / "sensor.yaml").read_text())
+        T_BS = matrix(sensor["T_BS"]["data"])
+        assert sensor["sensor_type"] == "camera" and sensor["T_BS"]["rows"] == sensor["T_BS"]["cols"] == 4
+        assert sensor["rate_hz"] == 10.0 and sensor["resolution"] == [32, 24]
+        cam = cams["views"][views[0]]["camera"]
+        assert sensor["camera_model"] == "pinhole" and sensor["distortion_model"] == "radial-tangential"
+        assert sensor["intrinsics"] == [cam["fx"], cam["fy"], cam["cx"], cam["cy"]] == [30.0, 31.0, 15.2, 11.7]
+        assert sensor["distortion_coefficients"] == cam["dist"][:4] == [-0.05, 0.01, 0.001, -0.002]
+        assert not any(cam["dist"][4:])
+        # T_BS composed with the ground-truth body pose is the camera's pose at each frame
+        for s, v in zip(stamps, views):
+            c = cams["views"][v]["cam_from_world"]
+            world_from_cam = np.linalg.inv(pose(c["R"], c["t"]))
+            assert np.abs(world_from_body[s] @ T_BS - world_from_cam).max() < 1e-9, (member, v)
+        # Kalibr: T_cam_imu is the inverse of T_BS; the same intrinsics
+        kc = chain[f"cam{k}"]
+        assert np.abs(matrix(kc["T_cam_imu"]) @ T_BS - np.eye(4)).max() < 1e-12
+        assert kc["intrinsics"] == sensor["intrinsics"] and kc["distortion_coeffs"] == sensor["distortion_coefficients"]
+        assert (kc["camera_model"], kc["distortion_model"], kc["resolution"]) == ("pinhole", "radtan", [32, 24])
+        assert str(kc["timeshift_cam_imu"]) == "0.0" and kc["rostopic"] == f"/cam{k}/image_raw"
+    # cam1's T_cn_cnm1 takes cam0 coordinates to cam1's: the rig's 0.1 m baseline
+    c1_from_c0 = matrix(chain["cam1"]["T_cn_cnm1"])
+    assert np.abs(c1_from_c0 - matrix(chain["cam1"]["T_cam_imu"]) @ np.linalg.inv(matrix(chain["cam0"]["T_cam_imu"]))
+                  ).max() < 1e-12
+    assert abs(np.linalg.norm(c1_from_c0[:3, 3]) - 0.1) < 1e-12 and "T_cn_cnm1" not in chain["cam0"]
+    # the IMU rows are the stream's measured values at its stamps
+    head, rows = read_csv(mav / "imu0" / "data.csv")
+    assert head == ["#timestamp [ns]", "w_RS_S_x [rad s^-1]", "w_RS_S_y [rad s^-1]", "w_RS_S_z [rad s^-1]",
+                    "a_RS_S_x [m s^-2]", "a_RS_S_y [m s^-2]", "a_RS_S_z [m s^-2]"]
+    values = np.array([[float(x) for x in r[1:]] for r in rows])
+    assert [int(r[0]) for r in rows] == [round(t * 1e9) for t in stream.field("stamp_s")]
+    assert np.array_equal(values[:, :3], stream.field("gyro_rad_s"))
+    assert np.array_equal(values[:, 3:], stream.field("accel_mps2"))
+    imu = cams["spec"]["sensors"]["imu"]["imu0"]
+    noise = ("gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
+             "accelerometer_random_walk")
+    sensor = yaml.safe_load((mav / "imu0" / "sensor.yaml").read_text())
+    assert sensor["sensor_type"] == "imu" and np.array_equal(matrix(sensor["T_BS"]["data"]), np.eye(4))
+    assert sensor["rate_hz"] == 200.0 and all(sensor[k] == imu[k] for k in noise)
+    kimu = yaml.safe_load((dest / "imu.yaml").read_text())["imu0"]
+    assert np.array_equal(matrix(kimu["T_i_b"]), np.eye(4)) and all(kimu[k] == imu[k] for k in noise)
+    assert kimu["update_rate"] == 200.0 and kimu["rostopic"] == "/imu0"
+
+
+@pytest.mark.render
+def test_a_dataset_without_an_imu_is_refused_with_exit_2(crossview_render, tmp_path, capsys):
+    dest = tmp_path / "euroc"
+    assert main(["export", str(crossview_render[1]), "--format", "euroc", "-o", str(dest)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no IMU stream" in err[0] and "Traceback" not in err[0]
+    assert not dest.exists() and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("camera, what", [
+    (Camera("fisheye", 32, 24, 30, 30, 15.5, 11.5, dist=(0.01, 0, 0, 0)), "fisheye camera model"),
+    (Camera("opencv", 32, 24, 30, 30, 15.5, 11.5, skew=0.5, dist=(0, 0, 0, 0)), "skew 0.5 px"),
+    (Camera("opencv", 32, 24, 30, 30, 15.5, 11.5, dist=(0.01, 0, 0, 0, 0.001)), "beyond k1 k2 p1 p2"),
+])
+def test_a_camera_radial_tangential_cannot_hold_is_refused(camera, what):
+    with pytest.raises(ExportError, match=what):
+        radtan_parameters(camera, "cam")
+    fu, _ = radtan_parameters(Camera("opencv", 32, 24, 30, 31, 15.5, 11.5, dist=(0.01, 0.002, 0, 0, 0)), "cam")
+    assert fu == [30.0, 31.0, 15.5, 11.5]
