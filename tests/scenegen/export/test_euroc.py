@@ -149,3 +149,23 @@ def test_a_camera_radial_tangential_cannot_hold_is_refused(camera, what):
         radtan_parameters(camera, "cam")
     fu, _ = radtan_parameters(Camera("opencv", 32, 24, 30, 31, 15.5, 11.5, dist=(0.01, 0.002, 0, 0, 0)), "cam")
     assert fu == [30.0, 31.0, 15.5, 11.5]
+
+
+@pytest.mark.render
+def test_one_camera_and_an_imu_clock_behind_the_rig(tmp_path):
+    """VIO as it is: one camera, the IMU stamping a sample taken at true time t with t - 0.005 s.
+    Kalibr's t_imu = t_cam + timeshift_cam_imu: the reading in the ground-truth row stamped T
+    (the camera's clock) is the IMU row stamped T + shift."""
+    spec = tmp_path / "vio.yaml"
+    spec.write_text(VIO)
+    render_spec(spec, tmp_path / "out", progress=False)
+    assert main(["export", str(tmp_path / "out"), "--format", "euroc", "-o", str(tmp_path / "e")]) == 0
+    mav = tmp_path / "e" / "mav0"
+    assert sorted(p.name for p in mav.iterdir()) == ["cam0", "imu0", "state_groundtruth_estimate0"]
+    chain = yaml.safe_load((tmp_path / "e" / "camchain.yaml").read_text())
+    assert list(chain) == ["cam0"] and chain["cam0"]["timeshift_cam_imu"] == -0.005
+    shift_ns = round(chain["cam0"]["timeshift_cam_imu"] * 1e9)
+    imu = [int(r[0]) for r in read_csv(mav / "imu0" / "data.csv")[1]]
+    truth = [int(r[0]) for r in read_csv(mav / "state_groundtruth_estimate0" / "data.csv")[1]]
+    assert len(imu) == len(truth) == 41 and [t + shift_ns for t in truth] == imu
+    assert imu[0] == 0 and truth[0] == 5_000_000
