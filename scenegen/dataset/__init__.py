@@ -16,23 +16,20 @@ knows paths (docs/dataset_format.md, docs/crossview.md).
 
 Nothing here imports Mitsuba or Dr.Jit.
 """
-from scenegen.dataset.cameras import ViewCamera
-from scenegen.dataset.errors import DatasetError, DatasetMismatchError
-from scenegen.dataset.journal import load_current_manifest
-from scenegen.dataset.layout import CAMERAS, MANIFEST, mesh_path, view_paths
-from scenegen.dataset.manifest import FORMAT, FORMAT_VERSION
-from scenegen.dataset.reader import Dataset
-from scenegen.dataset.stream_writer import StreamWriter
-from scenegen.dataset.streams import StreamField, StreamSchema
-from scenegen.dataset.truth import TRUTH_KEYS, TruthKind, check_truth
-from scenegen.dataset.verify import VerifyReport, verify
-from scenegen.dataset.view_files import encode_view, software_versions, write_view_files
-from scenegen.dataset.writer import DatasetWriter
+from scenegen.dataset.lazy import lazy_exports
 
-__all__ = [
-    "CAMERAS", "MANIFEST", "FORMAT", "FORMAT_VERSION", "TRUTH_KEYS", "TruthKind", "DatasetError",
-    "DatasetMismatchError",
-    "ViewCamera", "view_paths", "mesh_path", "check_truth", "encode_view", "write_view_files",
-    "software_versions", "DatasetWriter", "Dataset", "VerifyReport", "verify", "load_current_manifest",
-    "StreamField", "StreamSchema", "StreamWriter",
-]
+# name -> the submodule it comes from; loaded on first use (scenegen.dataset.lazy)
+__getattr__, __all__ = lazy_exports(__name__, {
+    "cameras": ("ViewCamera",),
+    "errors": ("DatasetError", "DatasetMismatchError"),
+    "journal": ("load_current_manifest",),
+    "layout": ("CAMERAS", "MANIFEST", "mesh_path", "view_paths"),
+    "manifest": ("FORMAT", "FORMAT_VERSION"),
+    "reader": ("Dataset",),
+    "stream_writer": ("StreamWriter",),
+    "streams": ("StreamField", "StreamSchema"),
+    "truth": ("TRUTH_KEYS", "TruthKind", "check_truth"),
+    "verify": ("VerifyReport", "verify"),
+    "view_files": ("encode_view", "software_versions", "write_view_files"),
+    "writer": ("DatasetWriter",),
+})

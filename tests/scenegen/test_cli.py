@@ -39,4 +39,11 @@ def test_validate_imports_no_renderer_codec_or_mesh_library():
     mods = _modules_after(f"from scenegen import cli\ncli.main(['validate', {str(ROOT / 'scenes/demo.yaml')!r}])")
     assert "scenegen.spec" in mods
     assert not _under(mods, ("mitsuba", "drjit", "OpenEXR", "trimesh", "dask", "distributed", "scenegen.pipeline",
-                             "scenegen.render", "scenegen.dataset", "scenegen.export"))
+                             "scenegen.render", "scenegen.export"))
+    # a sensor kind names its truth kinds and stream schema (numpy-only modules of the dataset);
+    # nothing that encodes, writes or reads a dataset is loaded
+    assert set(_under(mods, ("scenegen.dataset",))) <= {
+        "scenegen.dataset", "scenegen.dataset.lazy", "scenegen.dataset.truth_kinds", "scenegen.dataset.streams",
+        "scenegen.dataset.stream_writer", "scenegen.dataset.layout", "scenegen.dataset.files",
+        "scenegen.dataset.codecs", "scenegen.dataset.codecs.npy", "scenegen.dataset.codecs.json"}, \
+        _under(mods, ("scenegen.dataset",))

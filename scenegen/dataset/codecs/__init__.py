@@ -16,33 +16,19 @@ for ``read_*``). Identical inputs give identical bytes for the same library vers
 * :mod:`.tracks`: TAP-Vid-style point tracks as a pickle-free NPZ.
 * :mod:`.dng`: raw Bayer mosaics as DNG (own TIFF writer and reader, no TIFF library).
 """
-from scenegen.dataset.codecs.dng import DngRaw, decode_dng, encode_dng, read_dng, write_dng
-from scenegen.dataset.codecs.exr import decode_exr, encode_exr, pack_channels, read_exr, unpack_channels, write_exr
-from scenegen.dataset.codecs.flo import decode_flo, encode_flo
-from scenegen.dataset.codecs.json import decode_json, encode_json, read_json, write_json
-from scenegen.dataset.codecs.kitti import (
-                                         decode_kitti_disparity,
-                                         disparity_from_kitti_array,
-                                         encode_kitti_disparity,
-                                         kitti_disparity_array,
-)
-from scenegen.dataset.codecs.kitti_flow import decode_kitti_flow_png, encode_kitti_flow_png
-from scenegen.dataset.codecs.npy import decode_npy, decode_npz, encode_npy, encode_npz, read_npy, read_npz, write_npy
-from scenegen.dataset.codecs.pfm import decode_pfm, encode_pfm, read_pfm, write_pfm
-from scenegen.dataset.codecs.png import decode_png, encode_png, read_png, write_png
-from scenegen.dataset.codecs.sintel import decode_cam, decode_dpt, encode_cam, encode_dpt
-from scenegen.dataset.codecs.tracks import (
-    TRACK_KEYS, TrackSet, decode_tracks, encode_tracks, read_tracks, write_tracks,
-)
+from scenegen.dataset.lazy import lazy_exports
 
-__all__ = [
-    "DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng",
-    "decode_exr", "encode_exr", "pack_channels", "read_exr", "unpack_channels", "write_exr",
-    "decode_flo", "encode_flo", "decode_json", "encode_json", "read_json", "write_json",
-    "decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array",
-    "decode_kitti_flow_png", "encode_kitti_flow_png",
-    "decode_npy", "decode_npz", "encode_npy", "encode_npz", "read_npy", "read_npz", "write_npy",
-    "decode_pfm", "encode_pfm", "read_pfm", "write_pfm",
-    "decode_png", "encode_png", "read_png", "write_png", "decode_cam", "decode_dpt", "encode_cam", "encode_dpt",
-    "TRACK_KEYS", "TrackSet", "decode_tracks", "encode_tracks", "read_tracks", "write_tracks",
-]
+# name -> the submodule it comes from; loaded on first use (scenegen.dataset.lazy)
+__getattr__, __all__ = lazy_exports(__name__, {
+    "dng": ("DngRaw", "decode_dng", "encode_dng", "read_dng", "write_dng"),
+    "exr": ("decode_exr", "encode_exr", "pack_channels", "read_exr", "unpack_channels", "write_exr"),
+    "flo": ("decode_flo", "encode_flo"),
+    "json": ("decode_json", "encode_json", "read_json", "write_json"),
+    "kitti": ("decode_kitti_disparity", "disparity_from_kitti_array", "encode_kitti_disparity", "kitti_disparity_array"),
+    "kitti_flow": ("decode_kitti_flow_png", "encode_kitti_flow_png"),
+    "npy": ("decode_npy", "decode_npz", "encode_npy", "encode_npz", "read_npy", "read_npz", "write_npy"),
+    "pfm": ("decode_pfm", "encode_pfm", "read_pfm", "write_pfm"),
+    "png": ("decode_png", "encode_png", "read_png", "write_png"),
+    "sintel": ("decode_cam", "decode_dpt", "encode_cam", "encode_dpt"),
+    "tracks": ("TRACK_KEYS", "TrackSet", "decode_tracks", "encode_tracks", "read_tracks", "write_tracks"),
+})

@@ -13,12 +13,9 @@ import dataclasses
 
 import numpy as np
 
-from scenegen.assets.meshes import TARGET_KINDS, object_mesh
 from scenegen.errors import SpecError
-from scenegen.geometry import seeds
 from scenegen.located_yaml import Fields, Node, suggest
-from scenegen.physics import Body, DropError, DropSettings, bounding_radius, release_poses, settle, support_hull
-from scenegen.spec.model.geometry import Blob, SceneObject, Transform
+from scenegen.spec.model.geometry import TARGET_KINDS, Blob, SceneObject, Transform
 from scenegen.spec.model.meta import field_info, frozen_mapping
 from scenegen.spec.model.placement import PLACEMENT_TYPES, DropPlacement
 from scenegen.spec.parse.context import ParseContext
@@ -56,7 +53,10 @@ def parse_placement(node: Node, objects_node: Node | None,
     if "poses" in f:
         poses = _recorded_poses(f.get("poses"), names)
     else:
-        poses = _simulate(spec, [by_name[n] for n in names], by_name[onto], f)
+        # the engine (MuJoCo) and the meshes (trimesh) load only for a spec that drops objects:
+        # `scenegen validate` of any other spec stays light
+        from scenegen.spec.parse.placement_drop import simulate
+        poses = simulate(spec, [by_name[n] for n in names], by_name[onto], f)
     spec = dataclasses.replace(spec, poses=frozen_mapping(poses))
     objects = tuple(dataclasses.replace(o, transform=Transform(world_from_object=poses[o.name],
                                                                scale=o.transform.scale))
@@ -115,46 +115,6 @@ def _recorded_poses(node: Node, names: list[str]) -> dict:
     f = node.as_mapping("a mapping of the dropped objects' names to their settled poses (4x4 rows)")
     f.check(required=names)
     return {name: parse_pose(f.get(name)) for name in names}
-
-
-def _simulate(spec: DropPlacement, dropped: list[SceneObject], support: SceneObject, f: Fields) -> dict:
-    """Release, settle and check: {name: settled world_from_object}."""
-    def scaled(obj):
-        return np.asarray(object_mesh(obj.geometry)[0].vertices, np.float64) * np.asarray(obj.transform.scale)
-
-    try:
-        hull = support_hull(scaled(support), support.transform.world_from_object, support.name)
-    except DropError as e:
-        raise f.get("onto").error(str(e)) from None
-    vertices = [scaled(o) for o in dropped]
-    radii = [bounding_radius(v) for v in vertices]
-    top_z = float(hull.bounds[1][2])
-    regions = []
-    for obj, r in zip(dropped, radii):
-        if spec.region_min is not None:
-            regions.append((spec.region_min, spec.region_max))
-            continue
-        lo, hi = hull.bounds[0][:2] + r, hull.bounds[1][:2] - r
-        if np.any(lo > hi):
-            raise f.get("objects").error(
-                f"object {obj.name!r} (bounding radius {r:.3g} m) does not fit on the support {support.name!r} "
-                f"({np.ptp(hull.bounds[:, 0]):.3g} x {np.ptp(hull.bounds[:, 1]):.3g} m); give `region:`")
-        regions.append((tuple(lo), tuple(hi)))
-    releases = release_poses(radii, [o.transform.world_from_object.R for o in dropped], regions, top_z,
-                             spec.drop_height_m, spec.orientation, seeds.rng(spec.seed))
-    settings = DropSettings(friction=spec.friction, settle_s=spec.settle_s, rest_speed_m_s=spec.rest_speed_m_s)
-    try:
-        out = settle([Body(o.name, v, p) for o, v, p in zip(dropped, vertices, releases)], hull, settings)
-    except DropError as e:
-        raise f.get("objects").error(str(e)) from None
-    if not out.at_rest:
-        k = int(np.argmax(out.point_speed_m_s))
-        low = float(out.poses[k].apply(vertices[k])[:, 2].min())
-        why = f"; it fell off the support {support.name!r}" if low < top_z - 0.01 else ""
-        raise SpecError.at(spec.where, f"object {dropped[k].name!r} is still moving after settle_s "
-                           f"{spec.settle_s:g} s (a point at {out.point_speed_m_s[k]:.3g} m/s, rest_speed_m_s "
-                           f"{spec.rest_speed_m_s:g}){why}")
-    return {o.name: p for o, p in zip(dropped, out.poses)}
 
 
 def check_variation(placement: DropPlacement, variation, objects: tuple[SceneObject, ...]) -> None:

@@ -2,7 +2,7 @@
 into one image and its per-pixel truth per rig member and frame (docs/dataset_format.md)."""
 from __future__ import annotations
 
-from scenegen.dataset.truth import TRUTH_KEYS
+from scenegen.dataset.truth_kinds import TRUTH_KEYS
 from scenegen.spec.model.cameras import CameraSpec
 from scenegen.spec.parse.cameras import parse_camera
 from scenegen.spec.sensors.kind import VIEWS, SensorKind

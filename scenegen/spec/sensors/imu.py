@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenegen.dataset import StreamWriter
+from scenegen.dataset.stream_writer import StreamWriter
 from scenegen.dataset.streams import DEFAULT_CHUNK_SAMPLES, StreamField, StreamSchema
 from scenegen.errors import SpecError, Where
 from scenegen.geometry.clock import Composed, StaticTrajectory
