@@ -8,7 +8,8 @@ scattered around. The points: 80 % on the sphere with N(0, 5 mm) normal noise, 1
 floor and the slanted triangles, 10 % uniform in the 24 m box (outliers). Each side runs in its
 own process (fresh, so that its peak resident memory is its own), from .npy arrays to distances;
 times are wall clock of the distance call alone (mesh structure build included) and of the whole
-process. Open3D lives in its own venv (``benchmarks/.venv-open3d``, see bench_fscore.py), never
+process. ``--rounds`` alternate the two sides; the ``TARGET`` lines (issue 32) are the per-round
+time ratio <= 2 and peak-memory ratio <= 1.2. Open3D lives in its own venv (``benchmarks/.venv-open3d``, see bench_fscore.py), never
 the project's.
 
 Usage::
@@ -29,6 +30,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+from _common import ratios, target  # noqa: E402
 from bench_fscore import ensure_open3d_venv  # noqa: E402  (the shared Open3D venv)
 
 
@@ -109,6 +111,7 @@ def main() -> int:
     ap.add_argument("--subdiv", type=int, default=8, help="icosphere subdivisions (8: 1,310,720 triangles)")
     ap.add_argument("--worker", nargs=2, metavar=("SIDE", "FOLDER"), help=argparse.SUPPRESS)
     ap.add_argument("--no-open3d", action="store_true", help="recon_eval only")
+    ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of the two sides")
     a = ap.parse_args()
     if a.worker:
         (ours_worker if a.worker[0] == "ours" else open3d_worker)(a.worker[1])
@@ -117,25 +120,31 @@ def main() -> int:
     import numpy as np
 
     p, V, F = make_input(a.points, a.subdiv)
+    ours, o3d = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for k, arr in (("points", p), ("vertices", V), ("faces", F)):
             np.save(Path(tmp) / f"{k}.npy", arr)
-        ours, wall_ours = run([sys.executable, __file__, "--worker", "ours", tmp])
+        py = None if a.no_open3d else ensure_open3d_venv()
+        for _ in range(a.rounds):
+            ours.append(run([sys.executable, __file__, "--worker", "ours", tmp]))
+            if py is not None:
+                o3d.append(run([str(py), __file__, "--worker", "open3d", tmp], env={**os.environ, "PYTHONPATH": ""}))
         d_ours = np.load(Path(tmp) / "d_ours.npy")
-        o3d = None
-        if not a.no_open3d:
-            py = ensure_open3d_venv()
-            o3d, wall_o3d = run([str(py), __file__, "--worker", "open3d", tmp], env={**os.environ, "PYTHONPATH": ""})
-            d_o3d = np.load(Path(tmp) / "d_open3d.npy")
+        d_o3d = np.load(Path(tmp) / "d_open3d.npy") if o3d else None
     print(f"point-to-mesh distance, {len(p):,} points vs {len(F):,} triangles "
           f"(sphere of {len(F) - 2004:,} tiny + 4 large + 2,000 medium), {os.cpu_count()} CPU cores")
-    print(f"  recon_eval (exact float64 BVH): {ours['time_s']:7.2f} s, peak RSS {ours['peak_rss_mb']:7.0f} MB "
-          f"(process {wall_ours:.1f} s)")
-    if o3d is not None:
-        print(f"  Open3D {o3d['open3d']} compute_distance : {o3d['time_s']:7.2f} s, peak RSS {o3d['peak_rss_mb']:7.0f} MB "
-              f"(process {wall_o3d:.1f} s)")
-        print(f"  time ratio recon_eval / Open3D = {ours['time_s'] / o3d['time_s']:.2f}; memory ratio "
-              f"{ours['peak_rss_mb'] / o3d['peak_rss_mb']:.2f}")
+    for i, (r, wall) in enumerate(ours):
+        print(f"  round {i}: recon_eval (exact float64 BVH): {r['time_s']:7.2f} s, peak RSS {r['peak_rss_mb']:7.0f} MB "
+              f"(process {wall:.1f} s)")
+        if o3d:
+            r3, wall3 = o3d[i]
+            print(f"  round {i}: Open3D {r3['open3d']} compute_distance : {r3['time_s']:7.2f} s, peak RSS "
+                  f"{r3['peak_rss_mb']:7.0f} MB (process {wall3:.1f} s)")
+    if o3d:
+        t_ratio = ratios([r["time_s"] for r, _ in ours], [r["time_s"] for r, _ in o3d])
+        m_ratio = ratios([r["peak_rss_mb"] for r, _ in ours], [r["peak_rss_mb"] for r, _ in o3d])
+        print(target("mesh distance time / Open3D", t_ratio, 2.0))
+        print(target("mesh distance peak RSS / Open3D", m_ratio, 1.2))
         diff = np.abs(d_ours - d_o3d)
         rel = diff / np.maximum(d_ours, 1e-3)
         print(f"  |ours - Open3D|: max {diff.max():.2e} m, median {np.median(diff):.2e} m "

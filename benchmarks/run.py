@@ -2,7 +2,7 @@
 targets of docs/performance.md as ``TARGET`` lines, collected again at the end.
 
 Figures are recorded in docs/performance.md (render, truth, frames, start-up, scale, Cycles) and
-docs/metrics.md (F-score).
+docs/metrics.md (F-score, mesh distance).
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.py", "bench_codecs.py", "bench_fscore.py",
-           "bench_scale.py", "bench_flow.py", "bench_stages.py")
+           "bench_mesh_distance.py", "bench_scale.py", "bench_flow.py", "bench_stages.py")
 
 
 def run(script: str, targets: list[str]) -> int:

@@ -40,9 +40,8 @@ def closest_points_on_triangles(p, a, b, c) -> np.ndarray:
     """Closest point (K, 3) on triangle (a_k, b_k, c_k) to p_k; all inputs (K, 3).
 
     Ericson (2005) sec. 5.1.5, ``ClosestPtPointTriangle``, with the region tests applied in the
-    book's order (earlier tests take priority). Degenerate (zero-area) triangles fall back to the
-    nearest of their three edges' end points and edges handled by the region tests; any NaN left
-    is replaced by the nearest vertex.
+    book's order (earlier tests take priority). A zero-area triangle whose region tests leave NaN
+    (two coincident vertices) gets the nearest point of its three edges, its whole point set.
     """
     ab, ac, ap = b - a, c - a, p - a
     bp, cp = p - b, p - c
@@ -76,10 +75,27 @@ def closest_points_on_triangles(p, a, b, c) -> np.ndarray:
         out[m] = a[m]
     bad = ~np.all(np.isfinite(out), axis=1)
     if np.any(bad):
-        verts = np.stack([a[bad], b[bad], c[bad]], axis=1)  # (k, 3, 3)
-        j = np.argmin(np.linalg.norm(verts - p[bad][:, None, :], axis=2), axis=1)
-        out[bad] = verts[np.arange(len(j)), j]
+        out[bad] = _closest_points_on_edges(p[bad], a[bad], b[bad], c[bad])
     return out
+
+
+def _closest_points_on_edges(p, a, b, c) -> np.ndarray:
+    """Closest point (K, 3) to p_k on the three edges of (a_k, b_k, c_k): the whole point set of a
+    zero-area triangle (e.g. a = b: the segment ac, which Ericson's tests leave as NaN)."""
+    best, best_d = None, None
+    for s, e in ((a, b), (b, c), (c, a)):
+        se = e - s
+        ll = np.einsum("ij,ij->i", se, se)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(ll > 0, np.einsum("ij,ij->i", p - s, se) / ll, 0.0)
+        q = s + se * np.clip(t, 0.0, 1.0)[:, None]
+        d = np.einsum("ij,ij->i", p - q, p - q)
+        if best is None:
+            best, best_d = q, d
+        else:
+            closer = d < best_d
+            best[closer], best_d[closer] = q[closer], d[closer]
+    return best
 
 
 def point_triangle_sq_distances(p, a, b, c) -> np.ndarray:

@@ -80,3 +80,9 @@ class TestClosestPointOnTriangle:
         same = np.zeros((1, 3))
         q = closest_points_on_triangles(np.array([[1.0, 2.0, 2.0]]), same, same, same)
         np.testing.assert_array_equal(q, same)
+        # two coincident vertices: the "triangle" is the segment from (2, 2, 2) to (4, 4, 4)
+        a, c = np.array([[2.0, 2, 2]]), np.array([[4.0, 4, 4]])
+        for p, q_ref in (([3.0, 3.0, 5.0], [11 / 3, 11 / 3, 11 / 3]), ([0.0, 0.0, 0.0], [2.0, 2, 2]), ([9.0, 4, 4], [4.0, 4, 4])):
+            for tri in ((a, a, c), (a, c, a), (c, a, a)):
+                q = closest_points_on_triangles(np.array([p]), *tri)
+                np.testing.assert_allclose(q[0], q_ref, atol=1e-15)
