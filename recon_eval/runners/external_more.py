@@ -165,7 +165,7 @@ def homography(ds, out_dir, options) -> RunOutput:
     out = RunOutput()
     root = str(Path(ds.root).resolve())
     for i, j in pairs:
-        planes = ds.twoview(i, j).homographies
+        planes = ds.read(ds.dataset.crossview.twoview, i, j).homographies
         ci, _ = ds.camera(i)
         for plane, H_gt in planes.items():
             key = f"{check_view_name(i)}__{check_view_name(j)}/{check_name('plane', plane)}"
