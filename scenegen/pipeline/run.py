@@ -151,7 +151,7 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
     with ViewProgress(progress, len(todo)) as bar:
         for _ in range(skipped):
             bar.advance()
-        if dask_client is not None:  # workers render and write; recorded here in the run's order
+        if dask_client is not None:  # workers render and write; recorded here as their tasks finish
             rendered = render_views_dask(dask_client, source, writer, pending, spp=spp, seed=seed,
                                          variant=used.variant, on_done=bar.advance)
         else:  # a view is encoded and written on a thread while the next one renders
