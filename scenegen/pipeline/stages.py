@@ -20,7 +20,7 @@ from pathlib import Path
 
 from scenegen.dataset.files import FileSink, remove_stale_temp_files
 from scenegen.pipeline import crossview, sequence
-from scenegen.pipeline.distributed import note_stage_items, worker_scene
+from scenegen.pipeline.distributed import note_stage_items, shipped_value, worker_scene
 from scenegen.pipeline.progress import ViewProgress
 
 #: Item groups per worker: small enough to balance, large enough to share cached truth.
@@ -162,8 +162,10 @@ def _run_on_workers(name, plan, done, writer, files, *, client, source, spp, see
     groups = item_groups(items, GROUPS_PER_WORKER * n_workers, keys)
     out_dir = str(Path(writer.root).resolve())
     names = tuple(v.name for v in done)
-    futures = [client.submit(stage_items_task, name, source, out_dir, names, plan, [items[k] for k in g], spp, seed,
-                             variant, pure=False) for g in groups]
+    # the spec's source and the plan go to the workers once (tasks returning them), not in every task
+    shipped_source, shipped_plan = (client.submit(shipped_value, x, pure=False) for x in (source, plan))
+    futures = [client.submit(stage_items_task, name, shipped_source, out_dir, names, shipped_plan,
+                             [items[k] for k in g], spp, seed, variant, pure=False) for g in groups]
     entries = [None] * len(items)
     try:
         for fut, group in zip(futures, groups):
@@ -177,5 +179,7 @@ def _run_on_workers(name, plan, done, writer, files, *, client, source, spp, see
     finally:
         for fut in futures:
             fut.cancel()
+        shipped_source.release()
+        shipped_plan.release()
     remove_stale_temp_files(out_dir)  # a worker killed mid-write: its task ran again elsewhere
     return entries
