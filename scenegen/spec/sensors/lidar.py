@@ -91,7 +91,9 @@ def parse_lidar(node, name, ctx) -> LidarSpec:
     f = check_keys(node.as_mapping("a LiDAR (preset, pattern, elevations_deg, columns, rate_hz, ...)"), LidarSpec,
                    optional=("object_reflectivity",))
     values = read_fields(f, LidarSpec, skip=("object_reflectivity",))
-    base = LIDAR_PRESETS.get(values["preset"], {})
+    base = dict(LIDAR_PRESETS.get(values["preset"], {}))
+    if "elevations_deg" in f:  # channels of one's own: the preset's per-channel tables do not apply
+        base = {k: v for k, v in base.items() if k not in ("azimuth_offsets_deg", "firing_offsets_us")}
     for key in _PRESET_KEYS:  # derived fields: written, else the preset's, else the default
         values[key] = (read_value(f.get(key), field_info(LidarSpec, key)) if key in f
                        else base.get(key, _DEFAULTS[key]))
@@ -133,7 +135,6 @@ def check_pattern(lidar: LidarSpec, f, node) -> None:
 
 def lidar_to_yaml(lidar: LidarSpec) -> dict:
     out = write_fields(lidar)
-    out.pop("preset", None)  # every preset value is written out: the preset is not needed to read it back
     if lidar.object_reflectivity:
         out["object_reflectivity"] = dict(lidar.object_reflectivity)
     return out
