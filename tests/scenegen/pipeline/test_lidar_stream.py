@@ -136,3 +136,57 @@ def test_a_resumed_run_and_a_second_run_give_the_same_bytes(rendered, tmp_path):
     render_spec(spec, again, progress=False)
     stream_files = {p: b for p, b in files.items() if p.parts[0] == "streams"}
     assert stream_files and {p: b for p, b in tree(again).items() if p.parts[0] == "streams"} == stream_files
+
+
+def read_pcd(path: Path) -> np.ndarray:
+    """A binary PCD v0.7 read from the format's documentation (pointclouds.org, "The PCD file
+    format"): header lines up to DATA, then WIDTH x HEIGHT packed records of FIELDS / SIZE / TYPE."""
+    data = path.read_bytes()
+    head, fields = {}, None
+    pos = 0
+    while True:
+        end = data.index(b"\n", pos)
+        line = data[pos:end].decode("ascii")
+        pos = end + 1
+        if line.startswith("#"):
+            continue
+        key, *vals = line.split()
+        head[key] = vals
+        if key == "DATA":
+            break
+    assert head["VERSION"] == ["0.7"] and head["DATA"] == ["binary"]
+    kinds = {("F", "4"): "<f4", ("F", "8"): "<f8", ("U", "2"): "<u2", ("U", "4"): "<u4"}
+    fields = np.dtype([(n, kinds[(t, s)]) for n, t, s in zip(head["FIELDS"], head["TYPE"], head["SIZE"])])
+    n = int(head["WIDTH"][0]) * int(head["HEIGHT"][0])
+    assert int(head["POINTS"][0]) == n
+    return np.frombuffer(data, fields, count=n, offset=pos)
+
+
+def test_exports_read_back_with_independent_readers(rendered, tmp_path):
+    from scenegen.export import export
+
+    _, out = rendered
+    s = Dataset(out).streams["seq_lidar"]
+    first = s.field("sweep") == 0
+    r = s.field("measured_range_m")[first].reshape(-1)
+    keep = np.isfinite(r)
+    pts = s.field("measured_point_m")[first].reshape(-1, 3)[keep]
+    inten = s.field("intensity")[first].reshape(-1)[keep]
+    ring = s.field("ring")[first].reshape(-1)[keep]
+    assert 50 < keep.sum() < len(r) and np.all((inten > 0) & (inten <= 1))
+    for fmt in ("kitti-velodyne", "nuscenes-lidar", "lidar-pcd", "lidar-ply"):
+        export(out, fmt, tmp_path / fmt)
+    kitti = np.fromfile(tmp_path / "kitti-velodyne/seq_lidar/velodyne/000000.bin", dtype=np.float32).reshape(-1, 4)
+    assert np.array_equal(kitti, np.column_stack([pts, inten]).astype(np.float32))
+    nus = np.fromfile(tmp_path / "nuscenes-lidar/seq_lidar/000000.pcd.bin", dtype=np.float32).reshape(-1, 5)
+    assert np.array_equal(nus[:, :4], kitti) and np.array_equal(nus[:, 4], ring.astype(np.float32))
+    pcd = read_pcd(tmp_path / "lidar-pcd/seq_lidar/000000.pcd")
+    assert np.array_equal(np.column_stack([pcd["x"], pcd["y"], pcd["z"]]), pts.astype(np.float32))
+    assert np.array_equal(pcd["ring"], ring) and np.array_equal(pcd["range"], r[keep].astype(np.float32))
+    t = s.field("beam_time_s")[first].reshape(-1)[keep]
+    assert np.array_equal(pcd["time"], t - s.time_s[0])
+    ply = trimesh.load(tmp_path / "lidar-ply/seq_lidar/000001.ply")
+    second = s.field("sweep") == 1
+    keep1 = np.isfinite(s.field("measured_range_m")[second].reshape(-1))
+    assert np.array_equal(np.asarray(ply.vertices), s.field("measured_point_m")[second].reshape(-1, 3)[keep1]
+                          .astype(np.float32).astype(np.float64))
