@@ -126,9 +126,10 @@ def footprint_offsets(divergence_rad: float, rays: int) -> np.ndarray:
 
 
 def footprint_directions(directions, offsets) -> np.ndarray:
-    """(N, R, 3) unit ray directions of beams (N, 3) with footprint ``offsets`` (R, 2): each ray
-    tilted from its beam axis by ``a`` along the beam's horizontal tangent and ``b`` along the
-    tangent towards +z (offset (0, 0) is the axis itself, bit for bit)."""
+    """(N, R, 3) unit ray directions of beams (N, 3) with footprint ``offsets`` (R, 2): ray
+    ``(a, b)`` makes the angle ``sqrt(a^2 + b^2)`` with its beam's axis, towards ``a`` along the
+    beam's horizontal tangent (+azimuth) and ``b`` along its tangent towards +z (offset (0, 0) is
+    the axis itself, bit for bit)."""
     d = np.asarray(directions, np.float64)
     up = np.array([0.0, 0.0, 1.0])
     h = np.cross(up, d)  # horizontal tangent
@@ -136,11 +137,12 @@ def footprint_directions(directions, offsets) -> np.ndarray:
     h = np.where(hn > 1e-12, h / np.where(hn > 1e-12, hn, 1.0), np.array([0.0, 1.0, 0.0]))
     v = np.cross(d, h)
     a, b = offsets[:, 0], offsets[:, 1]
-    ta, tb = np.tan(a)[None, :, None], np.tan(b)[None, :, None]
-    rays = d[:, None, :] + ta * h[:, None, :] + tb * v[:, None, :]
-    rays /= np.linalg.norm(rays, axis=2, keepdims=True)
-    centre = (a == 0) & (b == 0)
-    rays[:, centre] = d[:, None, :]
+    ang = np.hypot(a, b)
+    safe = np.where(ang > 0, ang, 1.0)
+    ca, sa = np.cos(ang)[None, :, None], np.sin(ang)[None, :, None]
+    tangent = (a / safe)[None, :, None] * h[:, None, :] + (b / safe)[None, :, None] * v[:, None, :]
+    rays = ca * d[:, None, :] + sa * tangent
+    rays[:, ang == 0] = d[:, None, :]
     return rays
 
 
