@@ -86,11 +86,12 @@ def encode_ply(points) -> bytes:
 
 def _exporter(path_of, encode):
     def export(ds, dest, progress=None) -> dict:
+        total = sum(len(np.unique(ds.streams[s].field("sweep"))) for s in ds.streams.of_kind("lidar"))
         files = []
         for stream, k, points in sweep_points(ds):
             files.append(write(dest, path_of(stream, k), encode(points)))
             if progress is not None:
-                progress(len(files), len(files))
+                progress(len(files), total)
         return {"files": len(files), "sweeps": len(files)}
     return export
 

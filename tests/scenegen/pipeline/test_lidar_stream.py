@@ -190,3 +190,33 @@ def test_exports_read_back_with_independent_readers(rendered, tmp_path):
     keep1 = np.isfinite(s.field("measured_range_m")[second].reshape(-1))
     assert np.array_equal(np.asarray(ply.vertices), s.field("measured_point_m")[second].reshape(-1, 3)[keep1]
                           .astype(np.float32).astype(np.float64))
+
+
+def test_recon_eval_scores_a_hand_deskewed_sweep_and_the_raw_one(rendered, tmp_path):
+    """De-skewed by hand with the sensor's motion (10 m/s along +x, no rotation) to the sweep's
+    start: the error is the range noise's (none here: exact to float32), the raw cloud's the skew."""
+    import json
+
+    from recon_eval.cli import main as recon_main
+    from scenegen.export import export
+
+    _, out = rendered
+    export(out, "kitti-velodyne", tmp_path / "k")
+    raw = tmp_path / "k/seq_lidar/velodyne/000001.bin"
+    s = Dataset(out).streams["seq_lidar"]
+    rows = s.field("sweep") == 1
+    keep = np.isfinite(s.field("measured_range_m")[rows].reshape(-1))
+    t = s.field("beam_time_s")[rows].reshape(-1)[keep]
+    pts = np.fromfile(raw, np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
+    fixed = pts + np.column_stack([SPEED * (t - 0.1), 0 * t, 0 * t])  # into the LiDAR frame at 0.1 s
+    np.save(tmp_path / "fixed.npy", fixed)
+    assert recon_main(["lidar-deskew", str(tmp_path / "fixed.npy"), str(out), "--sweep", "1", "--quiet",
+                       "--json", str(tmp_path / "d.json")]) == 0
+    assert recon_main(["lidar-deskew", str(raw), str(out), "--sweep", "1", "--quiet",
+                       "--json", str(tmp_path / "r.json")]) == 0
+    fixed_res = json.loads((tmp_path / "d.json").read_text())["results"]["deskew"]
+    raw_res = json.loads((tmp_path / "r.json").read_text())["results"]["deskew"]
+    assert fixed_res["error_m"]["max"] < 2e-5  # float32 file rounding at 20 m
+    assert raw_res["error_m"]["max"] == pytest.approx(SPEED * (t.max() - 0.1), rel=1e-3)
+    np.save(tmp_path / "short.npy", fixed[:-1])
+    assert recon_main(["lidar-deskew", str(tmp_path / "short.npy"), str(out), "--sweep", "1"]) == 2
