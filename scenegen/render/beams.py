@@ -32,8 +32,12 @@ def cast_at_times(device, origins_world, directions_world, times_s) -> tuple[np.
     timeline = device.timeline
     if timeline is not None and device.description.movers:
         ts = device.timed()
-        t, hit, nrm, _, sid = timed_first_hit_at_times(ts, vec(o), vec(d), np.asarray(times_s, np.float64),
-                                                       timeline, device.alpha_masked, coherent=False)
+        # the movers posed once per distinct time, each ray gathering its own (beams that fire
+        # together, a beam's footprint rays)
+        unique_times, at = np.unique(np.asarray(times_s, np.float64), return_inverse=True)
+        t, hit, nrm, _, sid = timed_first_hit_at_times(ts, vec(o), vec(d), unique_times, timeline,
+                                                       device.alpha_masked, coherent=False,
+                                                       index=to_jit(mi.UInt32, at.astype(np.uint32), np.uint32))
         tables = ts.id_tables
     else:
         device.place_at(None)
@@ -45,7 +49,7 @@ def cast_at_times(device, origins_world, directions_world, times_s) -> tuple[np.
     oid = dr.select(hit, dr.gather(mi.UInt32, tables[0], sid), 0)
     iid = dr.select(hit, dr.gather(mi.UInt32, tables[1], sid), 0)
     dr.eval(dist, nrm, oid, iid)
-    normal = np.stack([np.asarray(nrm.x, np.float64), np.asarray(nrm.y, np.float64), np.asarray(nrm.z, np.float64)], 1)
+    normal = np.stack([nrm.x.numpy(), nrm.y.numpy(), nrm.z.numpy()], 1).astype(np.float64)
     dist = dist.numpy().copy()
     normal[~np.isfinite(dist)] = 0.0
     return dist, normal, oid.numpy().copy(), iid.numpy().copy()

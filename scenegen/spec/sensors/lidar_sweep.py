@@ -40,12 +40,18 @@ def sweep_fields(cast: Cast, lidar, pattern: ScanPattern, world_from_lidar, t0_s
     M, C = pattern.shape
     times = (t0_s + pattern.beam_time_s).reshape(-1)  # (N,)
     cast_times = times if static_time_s is None else np.full_like(times, static_time_s)
-    R, t = world_from_lidar.poses_at(cast_times)  # (N, 3, 3), (N, 3)
+    # beams that fire together share a pose: evaluated once per distinct time (exact, and a
+    # spinning head's 64 channels of a column are one time)
+    unique_times, at = np.unique(cast_times, return_inverse=True)
+    R_u, t_u = world_from_lidar.poses_at(unique_times)
+    R, t = R_u[at], t_u[at]  # (N, 3, 3), (N, 3)
     d_sensor = pattern.directions().reshape(-1, 3)
-    offsets = footprint_offsets(lidar.divergence_mrad * 1e-3, lidar.footprint_rays)
-    rays_sensor = footprint_directions(d_sensor, offsets)  # (N, F, 3); ray 0 is the axis
-    F = rays_sensor.shape[1]
-    rays_world = np.einsum("nij,nfj->nfi", R, rays_sensor)
+    F = lidar.footprint_rays
+    if F == 1:  # the axis alone
+        rays_world = np.einsum("nij,nj->ni", R, d_sensor)[:, None, :]
+    else:
+        rays_sensor = footprint_directions(d_sensor, footprint_offsets(lidar.divergence_mrad * 1e-3, F))  # (N, F, 3)
+        rays_world = np.einsum("nij,nfj->nfi", R, rays_sensor)  # ray 0 is the axis
     rng_, normal, oid, iid = cast(np.repeat(t, F, axis=0), rays_world.reshape(-1, 3), np.repeat(cast_times, F))
     rng_, oid, iid = rng_.reshape(-1, F), oid.reshape(-1, F), iid.reshape(-1, F)
     cos_inc = np.abs(np.einsum("nfi,nfi->nf", normal.reshape(-1, F, 3), rays_world))
@@ -58,7 +64,11 @@ def sweep_fields(cast: Cast, lidar, pattern: ScanPattern, world_from_lidar, t0_s
     in_range = hit & (rng_ >= lidar.min_range_m) & (rng_ <= lidar.max_range_m)
     valid = (in_range & (intensity >= lidar.min_intensity)
              & (cos_inc >= np.cos(np.radians(lidar.max_incidence_deg)) - 1e-15))
-    returns, return_int = select_returns(rng_, intensity, valid)
+    if F == 1:  # one ray: its return is first, strongest and last
+        returns = np.repeat(np.where(valid, rng_, np.inf), 3, axis=1)
+        return_int = np.repeat(np.where(valid, intensity, 0.0), 3, axis=1)
+    else:
+        returns, return_int = select_returns(rng_, intensity, valid)
     mode = RETURN_MODES.index(lidar.return_mode)
     gen = seeds.rng(*noise_key)
     noise = gen.standard_normal(len(times)) * lidar.range_noise_m
@@ -84,7 +94,7 @@ def sweep_fields(cast: Cast, lidar, pattern: ScanPattern, world_from_lidar, t0_s
         "object_id": shape(np.where(axis_hit, oid[:, 0], 0).astype(np.uint32)),
         "instance_id": shape(np.where(axis_hit, iid[:, 0], 0).astype(np.uint32)),
         "incidence_rad": shape(incidence),
-        "sensor_position_m": shape(t), "sensor_quat_wxyz": shape(quat_wxyz_from_matrix(R)),
+        "sensor_position_m": shape(t), "sensor_quat_wxyz": shape(quat_wxyz_from_matrix(R_u)[at]),
         "returns_m": shape(returns),
         "intensity": shape(np.where(has_return, return_int[:, mode], 0.0).astype(np.float32)),
         "measured_range_m": shape(measured),
