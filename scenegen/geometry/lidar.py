@@ -31,6 +31,7 @@ and last returns are the nearest, brightest and farthest of its rays' returns.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -56,9 +57,16 @@ class ScanPattern:
         """(M samples, C beams per sample)."""
         return self.beam_time_s.shape
 
+    @cached_property
+    def unit_directions(self) -> np.ndarray:
+        """(M, C, 3) unit beam directions in the LiDAR frame, computed once (read-only)."""
+        d = beam_directions(self.azimuth_rad, self.elevation_rad)
+        d.flags.writeable = False
+        return d
+
     def directions(self) -> np.ndarray:
         """(M, C, 3) unit beam directions in the LiDAR frame."""
-        return beam_directions(self.azimuth_rad, self.elevation_rad)
+        return self.unit_directions.copy()
 
     def rings(self, elevations_rad=None) -> np.ndarray:
         """(C,) each beam column's ring: its rank by nominal elevation, 0 = lowest (the ``ring``

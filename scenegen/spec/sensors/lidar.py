@@ -40,7 +40,7 @@ class LidarSpec:
     name: str
     preset: str | None = param(None, unit="LiDAR preset", choices=tuple(LIDAR_PRESETS),
                                doc_default="none; a preset's values are the defaults of the pattern keys not given")
-    pattern: str = param("spinning", unit="scan pattern", choices=PATTERNS, derived=_FROM_PRESET)
+    pattern: str = param("spinning", unit="scan pattern", choices=PATTERNS, derived=_FROM_PRESET + ", else spinning")
     elevations_deg: tuple[float, ...] | None = param(
         None, unit="degrees", lo=-90, hi=90, derived=_FROM_PRESET,
         doc_default="required for a spinning pattern without a preset: one per channel")
@@ -48,24 +48,24 @@ class LidarSpec:
                                                           doc_default="0 per channel")
     firing_offsets_us: tuple[float, ...] | None = param(None, unit="us", lo=0, derived="0 per channel",
                                                         doc_default="0 per channel (all fire at the column's start)")
-    columns: int = param(1024, unit="samples per sweep", lo=1, hi=100000, derived=_FROM_PRESET)
+    columns: int = param(1024, unit="samples per sweep", lo=1, hi=100000, derived=_FROM_PRESET + ", else 1024")
     rows: int = param(64, unit="raster lines", lo=1, hi=10000)
     fov_h_deg: float = param(120.0, unit="degrees", lo=0, lo_open=True, hi=180)
     fov_v_deg: float = param(25.0, unit="degrees", lo=0, hi=180)
-    rate_hz: float = param(10.0, unit="Hz", lo=0, lo_open=True, hi=1000.0, derived=_FROM_PRESET)
-    clockwise: bool = param(True, unit="spin seen from above", derived=_FROM_PRESET)
+    rate_hz: float = param(10.0, unit="Hz", lo=0, lo_open=True, hi=1000.0, derived=_FROM_PRESET + ", else 10")
+    clockwise: bool = param(True, unit="spin seen from above", derived=_FROM_PRESET + ", else true")
     start_azimuth_deg: float = param(0.0, unit="degrees", lo=-360, hi=360)
-    min_range_m: float = param(0.5, unit="m", lo=0, derived=_FROM_PRESET)
-    max_range_m: float = param(120.0, unit="m", lo=0, lo_open=True, derived=_FROM_PRESET)
+    min_range_m: float = param(0.5, unit="m", lo=0, derived=_FROM_PRESET + ", else 0.5")
+    max_range_m: float = param(120.0, unit="m", lo=0, lo_open=True, derived=_FROM_PRESET + ", else 120")
     divergence_mrad: float = param(0.0, unit="mrad (full angle)", lo=0, hi=100)
     footprint_rays: int = param(1, unit="rays per beam", lo=1, hi=64)
     return_mode: str = param("strongest", unit="return", choices=RETURN_MODES)
     range_noise_m: float = param(0.0, unit="m (1 sigma)", lo=0, hi=10)
-    reflectivity: float = param(0.5, unit="", lo=0, hi=1)
+    reflectivity: float = param(0.5, unit="fraction (objects not in object_reflectivity)", lo=0, hi=1)
     attenuation_per_m: float = param(0.0, unit="1/m", lo=0, hi=1)
-    min_intensity: float = param(0.0, unit="", lo=0, hi=1)
+    min_intensity: float = param(0.0, unit="intensity (below: no return)", lo=0, hi=1)
     max_incidence_deg: float = param(90.0, unit="degrees", lo=0, hi=90)
-    dropout_rate: float = param(0.0, unit="", lo=0, hi=1)
+    dropout_rate: float = param(0.0, unit="probability a return is lost", lo=0, hi=1)
     seed: int = param(0, unit="seed", label="", lo=0, hi=SEED_MAX, derived="seed32(scene seed, field path)")
     object_reflectivity: object = field(default_factory=frozen_mapping)  # object name -> reflectivity
     where: Where | None = where_field()

@@ -45,7 +45,7 @@ def sweep_fields(cast: Cast, lidar, pattern: ScanPattern, world_from_lidar, t0_s
     unique_times, at = np.unique(cast_times, return_inverse=True)
     R_u, t_u = world_from_lidar.poses_at(unique_times)
     R, t = R_u[at], t_u[at]  # (N, 3, 3), (N, 3)
-    d_sensor = pattern.directions().reshape(-1, 3)
+    d_sensor = pattern.unit_directions.reshape(-1, 3)
     F = lidar.footprint_rays
     if F == 1:  # the axis alone
         rays_world = np.einsum("nij,nj->ni", R, d_sensor)[:, None, :]
