@@ -84,3 +84,15 @@ def test_each_beam_is_posed_at_its_own_time():
     hit = f["object_id"] == 1
     assert np.allclose(f["point_world_m"][..., 0][hit],
                        10.0 * f["beam_time_s"][hit] + f["point_sensor_m"][..., 0][hit], atol=1e-12)
+
+
+def test_a_raster_sweep_sees_the_ground_where_its_lines_point():
+    spec = lidar(pattern="raster", fov_h_deg=60.0, fov_v_deg=20.0, rows=8, columns=16, elevations_deg=None)
+    tilted = StaticTrajectory(Rigid3(np.array([[np.cos(-0.3), 0, np.sin(-0.3)], [0, 1, 0],
+                                               [-np.sin(-0.3), 0, np.cos(-0.3)]]).T, np.array([0.0, 0.0, HEIGHT])))
+    f = sweep(spec, traj=tilted)  # pitched down by 0.3 rad: every line meets the ground
+    assert f["range_m"].shape == (8, 16) and np.isfinite(f["range_m"]).all()
+    d_world = f["point_world_m"] - f["sensor_position_m"]
+    assert np.allclose(f["point_world_m"][..., 2][f["object_id"] == 1], 0.0, atol=1e-12)
+    assert np.allclose(np.linalg.norm(d_world, axis=-1), f["range_m"], rtol=1e-12)
+    assert np.all(np.diff(f["beam_time_s"].reshape(-1)) > 0)
