@@ -13,7 +13,8 @@
 A point is a beam's measured return (``measured_point_m``: the LiDAR frame at the beam's own time,
 the raw, motion-skewed cloud a sensor's driver gives); beams without a return are left out.
 ``intensity`` / ``reflectance`` is the return model's ``rho cos(incidence) exp(-2 alpha r)`` in
-[0, 1]; ``ring`` the beam's rank by elevation (0 = lowest); ``time`` (float64, s) the beam's time
+[0, 1] (KITTI's reflectance is in [0, 1] too; nuScenes' recorded intensities are 0-255: scale by
+255 to compare); ``ring`` the beam's rank by elevation (0 = lowest); ``time`` (float64, s) the beam's time
 after its sweep's first sample; ``range`` the measured range (m).
 """
 from __future__ import annotations
