@@ -21,7 +21,9 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``sintel``: MPI-Sintel layout (final/, flow/, occlusions/, invalid/, depth/, camdata_left/) per
   camera stream of a sequence of pinhole cameras;
 * ``euroc``: EuRoC MAV ``mav0/`` (camN images and data.csv, imu0, state_groundtruth_estimate0,
-  sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU.
+  sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU;
+* ``kitti-velodyne``, ``nuscenes-lidar``, ``lidar-pcd``, ``lidar-ply``: a LiDAR stream's sweeps as
+  KITTI ``.bin``, nuScenes ``.pcd.bin``, PCD and PLY point clouds (:mod:`.lidar`).
 """
 from __future__ import annotations
 
@@ -34,6 +36,7 @@ from scenegen.export import (
     kitti_flow,
     kitti_sceneflow,
     kitti_stereo,
+    lidar,
     middlebury,
     nerf,
     opencv_yaml,
@@ -51,13 +54,15 @@ FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.exp
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
            "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
-           "euroc": euroc.export}
+           "euroc": euroc.export, "kitti-velodyne": lidar.export_kitti, "nuscenes-lidar": lidar.export_nuscenes,
+           "lidar-pcd": lidar.export_pcd, "lidar-ply": lidar.export_ply}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
                   "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
-                  "euroc": "views"}
+                  "euroc": "views", "kitti-velodyne": "sweeps", "nuscenes-lidar": "sweeps", "lidar-pcd": "sweeps",
+                  "lidar-ply": "sweeps"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

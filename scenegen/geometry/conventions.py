@@ -16,6 +16,9 @@ Internal conventions (used everywhere in scenegen and recon_eval):
   ``GRAVITY_WORLD_MPS2 = (0, 0, -9.80665)`` m/s^2 (standard gravity, pointing down), and an
   accelerometer measures the specific force ``f_body = R_world_from_body^T (a_world - g_world)``:
   at rest with +z up it reads (0, 0, +9.80665) (:mod:`scenegen.geometry.imu`).
+* A LiDAR's frame: +x forward, +y left, +z up (a Velodyne's, KITTI's velodyne frame); a beam's
+  azimuth counter-clockwise from +x seen from above, its elevation up from the xy plane
+  (:mod:`scenegen.geometry.lidar`).
 
 Foreign conventions, one function (or constant) each:
 

@@ -48,9 +48,9 @@ def _rotation_class():
 
 
 def quat_wxyz_from_matrix(R) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) with w >= 0 of a (3, 3) rotation matrix."""
+    """Unit quaternion (w, x, y, z) with w >= 0 of a (3, 3) rotation matrix, or (N, 4) of (N, 3, 3)."""
     q = _rotation_class().from_matrix(np.asarray(R, float)).as_quat(scalar_first=True)
-    return q if q[0] >= 0 else -q
+    return np.where(q[..., :1] >= 0, q, -q)
 
 
 def matrix_from_quat_wxyz(q_wxyz) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast
 from scenegen.render.albedo import albedo_pass
+from scenegen.render.beams import cast_at_times
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
 from scenegen.render.frames import render_ideal, render_view
@@ -103,6 +104,12 @@ class Caster:
         dev = self._at(time_s)
         timed = None if moves is None else (dev.timed(), moves)
         return raycast.surface_points(dev.scene, camera, cam_from_world, uv, dev.alpha_masked, rows, timed)
+
+    def cast_at_times(self, origins_world, directions_world, times_s):
+        """((N,) range m (inf: none), (N, 3) unit normals, (N,) object ids, (N,) instance ids) of
+        rays (N, 3) each cast at its own time (N,) s with the moving objects there
+        (:func:`scenegen.render.beams.cast_at_times`: a LiDAR's beams)."""
+        return cast_at_times(self.device, origins_world, directions_world, times_s)
 
     def _at(self, time_s: float | None) -> DeviceScene:
         self.device.place_at(time_s)

@@ -25,6 +25,7 @@ from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_field
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
+from scenegen.spec.sensors.lidar import LidarSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -197,6 +198,12 @@ CASES += [
      lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
     (ImuSpec, "rate_hz", "imus:\n  imu0: {}\n", lambda s: s.sensors["imu"]["imu0"].rate_hz, 100.0),
 ]
+CASES += [(LidarSpec, key, "lidars:\n  l0: {elevations_deg: [0]}\n",
+           lambda s, key=key: getattr(s.sensors["lidar"]["l0"], key), other)
+          for key, other in (("rows", 32), ("fov_h_deg", 90.0), ("fov_v_deg", 10.0), ("start_azimuth_deg", 5.0),
+                             ("divergence_mrad", 1.0), ("footprint_rays", 3), ("return_mode", "last"),
+                             ("range_noise_m", 0.1), ("reflectivity", 0.3), ("attenuation_per_m", 0.01),
+                             ("min_intensity", 0.1), ("max_incidence_deg", 80.0), ("dropout_rate", 0.1))]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
