@@ -79,14 +79,16 @@ def read_image(path) -> np.ndarray:
 
 # --- poses -------------------------------------------------------------------------------------
 def sniff_trajectory(path: Path) -> str:
-    """'tum' (8 numbers per line) or 'kitti' (12), from the first non-comment line."""
+    """'tum' (8 numbers per line, or ov_eval's 20 with covariances) or 'kitti' (12), from the first
+    non-comment line."""
     for ln in read_text(path, "a TUM or KITTI trajectory").splitlines():
         ln = ln.split("#", 1)[0].replace(",", " ").strip()
         if ln:
             n = len(ln.split())
-            if n in (8, 12):
-                return "tum" if n == 8 else "kitti"
-            raise InputError(f"{path}:1: expected 8 (TUM) or 12 (KITTI odometry) numbers per line, got {n}")
+            if n in (8, 12, 20):
+                return "kitti" if n == 12 else "tum"
+            raise InputError(f"{path}:1: expected 8 (TUM) or 12 (KITTI odometry) numbers per line, got {n} "
+                             "(20: TUM with ov_eval's covariances)")
     raise InputError(f"{path}: empty trajectory (expected TUM or KITTI lines)")
 
 
