@@ -25,8 +25,10 @@ from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
 
 def arguments(p) -> None:
-    p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM or KITTI odometry trajectory, or a dataset")
-    p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file")
+    p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM (or ov_eval's with covariances) or KITTI "
+                                 "odometry trajectory, or a dataset")
+    p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file, "
+                                "EuRoC ground-truth data.csv")
     p.add_argument("--alignment", choices=list(POSE_ALIGNMENTS), default="sim3",
                    help="evo's alignments: se3 = --align, sim3 = --align --correct_scale, scale = --correct_scale "
                         "alone, origin = --align_origin (default sim3)")

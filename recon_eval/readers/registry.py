@@ -23,6 +23,7 @@ from recon_eval.metrics.poses import Poses
 from recon_eval.readers.colmap_binary import read_colmap_binary
 from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.readers.exr import read_exr_map
+from recon_eval.readers.euroc import is_euroc_groundtruth, read_euroc_groundtruth
 from recon_eval.readers.kitti_odometry import read_kitti_poses
 from recon_eval.readers.kitti_png import read_kitti_disparity
 from recon_eval.readers.nerf import read_nerf_transforms
@@ -128,6 +129,7 @@ POSE_FORMATS = (
                lambda p, camera, conv: read_colmap_text(p).poses),
     PoseFormat("nerf", lambda p: p.is_file() and p.suffix.lower() == ".json",
                lambda p, camera, conv: read_nerf_transforms(p).poses),
+    PoseFormat("tum", is_euroc_groundtruth, lambda p, camera, conv: read_euroc_groundtruth(p)),  # stamped, as TUM
     PoseFormat("tum", lambda p: p.is_file() and sniff_trajectory(p) == "tum", lambda p, camera, conv: read_tum(p)),
     PoseFormat("kitti", lambda p: p.is_file() and sniff_trajectory(p) == "kitti",
                lambda p, camera, conv: read_kitti_poses(p, conv)),

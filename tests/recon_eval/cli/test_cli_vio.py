@@ -83,3 +83,12 @@ def test_mixed_line_lengths_are_refused(files, tmp_path, capsys):
     assert run(["poses", bad, files / "gt.txt"]) == 2
     err = capsys.readouterr().err
     assert "bad.txt:2: expected 20 numbers as the lines above" in err and "Traceback" not in err
+
+
+def test_a_bad_euroc_groundtruth_row_is_refused(files, tmp_path, capsys):
+    bad = tmp_path / "data.csv"
+    bad.write_text("#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z []\n"
+                   "100000000000,0,0,0,1,0,0,0\n100050000000,0,0,x,1,0,0,0\n")
+    assert run(["poses", files / "est.txt", bad]) == 2
+    err = capsys.readouterr().err
+    assert "data.csv:3: not an integer timestamp and numbers" in err and "Traceback" not in err
