@@ -25,6 +25,7 @@ from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_field
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
+from scenegen.spec.sensors.wheel_odometry import WheelOdometrySpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -197,6 +198,10 @@ CASES += [
      lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
     (ImuSpec, "rate_hz", "imus:\n  imu0: {}\n", lambda s: s.sensors["imu"]["imu0"].rate_hz, 100.0),
 ]
+CASES += [(WheelOdometrySpec, key, "wheel_odometry:\n  w: {}\n",
+           lambda s, key=key: getattr(s.sensors["wheel_odometry"]["w"], key), other)
+          for key, other in [("rate_hz", 20.0), ("wheel_radius_m", 0.2), ("track_width_m", 0.3), ("slip_left", 0.1),
+                             ("slip_right", 0.1), ("wheel_speed_noise_rad_s", 0.5)]]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
