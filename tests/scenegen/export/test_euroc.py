@@ -10,6 +10,7 @@ import json
 import sys
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 import yaml
@@ -243,3 +244,49 @@ def test_evo_reads_our_tum_kitti_and_euroc_trajectories_and_gives_recon_evals_ap
         worst = max(worst, abs(ape["trans_stats_m"]["rmse"] - rmse))
     assert worst < 1e-12
     print(f"evo vs recon-eval APE rmse on TUM / KITTI / EuRoC files: max difference {worst:.1e} m")
+
+
+def _fs_matrix(node) -> np.ndarray:
+    """A FileStorage node: an ``!!opencv-matrix`` or a sequence of rows."""
+    if node.isSeq():
+        return np.array([[node.at(i).at(j).real() for j in range(node.at(i).size())] for i in range(node.size())])
+    return node.mat().astype(np.float64)
+
+
+@pytest.mark.render
+def test_orbslam3_and_openvins_settings_load_in_opencv_with_the_true_calibration(exported):
+    """ORB-SLAM3 and OpenVINS read their settings with cv::FileStorage: so do we here (cv2), and
+    compare every calibration value with EuRoC's sensor.yaml files (read with PyYAML)."""
+    _, dest = exported
+    sensors = [yaml.safe_load((dest / "mav0" / f"cam{k}" / "sensor.yaml").read_text()) for k in (0, 1)]
+    imu = yaml.safe_load((dest / "mav0" / "imu0" / "sensor.yaml").read_text())
+    T_BS = [matrix(s["T_BS"]["data"]) for s in sensors]
+    fs = cv2.FileStorage(str(dest / "orbslam3.yaml"), cv2.FILE_STORAGE_READ)
+    assert fs.isOpened() and fs.getNode("File.version").string() == "1.0"
+    assert fs.getNode("Camera.type").string() == "PinHole"
+    for k, s in enumerate(sensors, start=1):
+        got = [fs.getNode(f"Camera{k}.{n}").real() for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2")]
+        assert got == s["intrinsics"] + s["distortion_coefficients"]
+    assert (fs.getNode("Camera.width").real(), fs.getNode("Camera.height").real()) == (32, 24)
+    assert fs.getNode("Camera.fps").real() == 10.0
+    # dt: f, as ORB-SLAM3's own files: float32 of the truth
+    assert np.abs(_fs_matrix(fs.getNode("IMU.T_b_c1")) - T_BS[0]).max() < 1e-7
+    assert np.abs(_fs_matrix(fs.getNode("Stereo.T_c1_c2")) - np.linalg.inv(T_BS[0]) @ T_BS[1]).max() < 1e-7
+    assert fs.getNode("IMU.NoiseGyro").real() == imu["gyroscope_noise_density"] == 0.001
+    assert fs.getNode("IMU.AccWalk").real() == imu["accelerometer_random_walk"]
+    assert fs.getNode("IMU.Frequency").real() == 200.0
+    ov = cv2.FileStorage(str(dest / "openvins" / "kalibr_imucam_chain.yaml"), cv2.FILE_STORAGE_READ)
+    for k, s in enumerate(sensors):
+        cam = ov.getNode(f"cam{k}")
+        assert np.array_equal(_fs_matrix(cam.getNode("T_imu_cam")), T_BS[k])
+        assert [cam.getNode("intrinsics").at(i).real() for i in range(4)] == s["intrinsics"]
+        assert [cam.getNode("distortion_coeffs").at(i).real() for i in range(4)] == s["distortion_coefficients"]
+        assert cam.getNode("distortion_model").string() == "radtan" and cam.getNode("timeshift_cam_imu").real() == 0
+        assert cam.getNode("cam_overlaps").at(0).real() == 1 - k
+    imu_chain = cv2.FileStorage(str(dest / "openvins" / "kalibr_imu_chain.yaml"), cv2.FILE_STORAGE_READ)
+    oi = imu_chain.getNode("imu0")  # the FileStorage must outlive its nodes
+    assert oi.getNode("gyroscope_noise_density").real() == 0.001 and oi.getNode("update_rate").real() == 200.0
+    assert oi.getNode("model").string() == "kalibr" and np.array_equal(_fs_matrix(oi.getNode("Tg")), np.zeros((3, 3)))
+    est = cv2.FileStorage(str(dest / "openvins" / "estimator_config.yaml"), cv2.FILE_STORAGE_READ)
+    assert est.getNode("max_cameras").real() == 2 and est.getNode("gravity_mag").real() == 9.80665
+    assert est.getNode("relative_config_imucam").string() == "kalibr_imucam_chain.yaml"
