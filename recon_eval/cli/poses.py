@@ -111,9 +111,12 @@ def score(a):
                          "TUM trajectory on the other side")
     stamped = None
     if ek == "tum" and a.association == "evo":
-        stamped = score_stamped(est, gt, max_diff_s=a.max_time_diff, offset_s=a.t_offset, alignment=a.rpg_alignment,
-                                n_aligned=a.rpg_n_aligned, lengths_m=a.rpg_lengths, durations_s=a.drift_durations,
-                                nees_alignment=a.nees_alignment)
+        try:
+            stamped = score_stamped(est, gt, max_diff_s=a.max_time_diff, offset_s=a.t_offset,
+                                    alignment=a.rpg_alignment, n_aligned=a.rpg_n_aligned, lengths_m=a.rpg_lengths,
+                                    durations_s=a.drift_durations, nees_alignment=a.nees_alignment)
+        except InputError as exc:  # e.g. a straight truth path: rpg's alignment undetermined; APE/RPE still scored
+            stamped = f"not scored: {exc}"
         est, gt = associated_poses(est, gt, associate_evo(gt.timestamps_s, est.timestamps_s, a.max_time_diff,
                                                           a.t_offset))
         matching = f"TUM timestamps within {a.max_time_diff} s, estimate shifted by {a.t_offset} s (evo)"
