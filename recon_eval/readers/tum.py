@@ -42,7 +42,8 @@ def read_tum(path) -> TumTrajectory:
             continue
         tok = ln.split()
         if len(tok) not in (8, 20) or (rows and len(tok) != len(rows[0])):
-            want = f"{len(rows[0])} numbers as the lines above" if rows else "8 numbers (timestamp tx ty tz qx qy qz qw)"
+            want = (f"{len(rows[0])} numbers as the lines above" if rows
+                    else "8 numbers (timestamp tx ty tz qx qy qz qw)")
             raise InputError(f"{p}:{k}: expected {want} (or ov_eval's 20 with covariances), got {len(tok)}")
         try:
             rows.append([float(v) for v in tok])

@@ -36,7 +36,8 @@ def associated_poses(est: TumTrajectory, gt: TumTrajectory, a: Association) -> t
                 e_idx.append(i)
                 e_names.append(nm)
     G, E = gt.poses, est.poses
-    return (Poses(tuple(e_names), E.R_cam_from_world[e_idx].reshape(-1, 3, 3), E.t_cam_from_world[e_idx].reshape(-1, 3)),
+    return (Poses(tuple(e_names), E.R_cam_from_world[e_idx].reshape(-1, 3, 3),
+                  E.t_cam_from_world[e_idx].reshape(-1, 3)),
             Poses(tuple(g_names), G.R_cam_from_world[g_idx], G.t_cam_from_world[g_idx]))
 
 

@@ -34,7 +34,8 @@ def run():
     R_gt = Rotation.from_euler("ZYX", np.stack([0.4 * s, 0.2 * np.sin(s), 0.15 * np.cos(0.7 * s)], 1)).as_matrix()
     drift = np.cumsum(rng.normal(0, 0.004, (N, 3)), 0)
     p_e = p_gt + drift + rng.normal(0, 0.01, (N, 3))
-    R_e = Rotation.from_rotvec(np.cumsum(rng.normal(0, 0.002, (N, 3)), 0) + rng.normal(0, 0.01, (N, 3))).as_matrix() @ R_gt
+    wobble = np.cumsum(rng.normal(0, 0.002, (N, 3)), 0) + rng.normal(0, 0.01, (N, 3))
+    R_e = Rotation.from_rotvec(wobble).as_matrix() @ R_gt
     S = Rotation.from_euler("xyz", [0.3, -0.2, 1.1]).as_matrix()
     p_e = 0.8 * p_e @ S.T + [1.0, -2.0, 0.5]
     R_e = S @ R_e

@@ -37,7 +37,8 @@ def files(tmp_path_factory):
     # the estimate at its own 30 Hz clock, 0.02 s late, drifting; ov_eval's covariance columns
     te = 100.0 + np.arange(320) * (1 / 30) + 0.02
     se = te - 0.02 - t[0]
-    ce = np.stack([np.cos(0.5 * se) * 3, np.sin(0.5 * se) * 2, 0.2 * se], 1) + np.cumsum(rng.normal(0, 0.01, (320, 3)), 0)
+    ce = np.stack([np.cos(0.5 * se) * 3, np.sin(0.5 * se) * 2, 0.2 * se], 1)
+    ce = ce + np.cumsum(rng.normal(0, 0.01, (320, 3)), 0)
     Re = Rotation.from_euler("ZYX", np.stack([0.5 * se, 0.1 * np.sin(se), 0.05 * se], 1)).as_matrix()
     upper = np.tile([1e-4, 0, 0, 1e-4, 0, 1e-4, 4e-4, 0, 0, 4e-4, 0, 4e-4], (320, 1))
     (d / "est.txt").write_text(_lines(te, ce, Re))

@@ -96,7 +96,8 @@ def test_wheel_speeds_agree_with_central_differences_on_a_spline():
     Rp, tp = traj.poses_at(t + h)
     Rm, tm = traj.poses_at(t - h)
     v_fd = np.einsum("nji,nj->ni", truth.R, (tp - tm) / (2 * h))[:, 0]
-    yaw_fd = (planar_pose(truth.R[0], truth.t[0], Rp, tp)[:, 2] - planar_pose(truth.R[0], truth.t[0], Rm, tm)[:, 2]) / (2 * h)
+    yaw_p = planar_pose(truth.R[0], truth.t[0], Rp, tp)[:, 2]
+    yaw_fd = (yaw_p - planar_pose(truth.R[0], truth.t[0], Rm, tm)[:, 2]) / (2 * h)
     want = DRIVE.wheel_speeds_rad_s(v_fd, yaw_fd)
     # central differences: O(h^2 x third derivative) ~ 1e-10, rounding ~ 1e-16 / h = 1e-11
     assert np.abs(truth.wheel_speeds_rad_s - want).max() < 1e-7

@@ -113,7 +113,8 @@ def test_every_camera_member_form_is_the_spec_it_always_was(tmp_path, member):
 
 
 @pytest.mark.parametrize("text,line,message", [
-    (MULTI % "{kind: clock, sensor: cam}", 4, "expected one of 'camera', 'imu', 'wheel_odometry' (sensor kind), got 'clock'"),
+    (MULTI % "{kind: clock, sensor: cam}", 4,
+     "expected one of 'camera', 'imu', 'wheel_odometry' (sensor kind), got 'clock'"),
     ("clocks: {clk0: {}}\n" + MULTI % "{camera: cam}", 1, "unknown key 'clocks'"),
     (MULTI % "{camera: cam, time_offset_s: 0.01}", 4,
      "a camera member samples at its rig's time (time_offset_s 0); got 0.01 s"),
