@@ -8,7 +8,9 @@ from pathlib import Path, PurePosixPath
 from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.poses import DELTA_UNITS, POSE_ALIGNMENTS, Poses, ape, relative_pose, rpe
+from recon_eval.metrics.association import associate_evo
 from recon_eval.metrics.kitti_odometry import KITTI_LENGTHS_M, kitti_odometry
+from recon_eval.metrics.rpg_trajectory import RPG_ALIGNMENTS
 from recon_eval.metrics.sfm import reconstruction_stats
 from recon_eval.readers.colmap_binary import read_colmap_binary
 from recon_eval.readers.colmap_text import read_colmap_text
@@ -17,13 +19,16 @@ from recon_eval.readers.tum import associate
 from recon_eval.report import plots
 from recon_eval.report.html import Figure
 from recon_eval.tasks.headlines import trajectory_headline
+from recon_eval.tasks.stamped_trajectory import associated_poses, score_stamped
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.conventions import opencv_from_colmap_pixels
 
 
 def arguments(p) -> None:
-    p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM or KITTI odometry trajectory, or a dataset")
-    p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file")
+    p.add_argument("est", help="COLMAP model dir, NeRF transforms.json, TUM (or ov_eval's with covariances) or KITTI "
+                                 "odometry trajectory, or a dataset")
+    p.add_argument("gt", help="dataset folder (cameras.json), COLMAP model dir, transforms.json, TUM or KITTI file, "
+                                "EuRoC ground-truth data.csv")
     p.add_argument("--alignment", choices=list(POSE_ALIGNMENTS), default="sim3",
                    help="evo's alignments: se3 = --align, sim3 = --align --correct_scale, scale = --correct_scale "
                         "alone, origin = --align_origin (default sim3)")
@@ -40,7 +45,23 @@ def arguments(p) -> None:
     p.add_argument("--rpe-gaps", choices=["bridge", "fail"], default="bridge",
                    help="RPE across an unregistered camera: bridge = pair the registered poses as evo does "
                         "(default; broken truth-frame pairs still counted as failures), fail = no bridging")
-    p.add_argument("--max-time-diff", type=float, default=0.01, help="TUM timestamp association, seconds")
+    p.add_argument("--max-time-diff", "--t_max_diff", type=float, default=0.01,
+                   help="TUM timestamp association: largest difference, seconds (evo --t_max_diff)")
+    p.add_argument("--t-offset", "--t_offset", type=float, default=0.0,
+                   help="TUM: seconds added to the estimate's stamps before association (evo --t_offset)")
+    p.add_argument("--association", choices=["evo", "tum"], default="evo",
+                   help="TUM stamps: evo = nearest stamp from the shorter trajectory (evo's associate_trajectories; "
+                        "default), tum = unique pairs greedy by difference (TUM associate.py)")
+    p.add_argument("--rpg-alignment", choices=list(RPG_ALIGNMENTS), default="sim3",
+                   help="TUM stamps: rpg_trajectory_evaluation's alignment for its absolute and relative errors")
+    p.add_argument("--rpg-n-aligned", type=int, default=-1,
+                   help="rpg align_num_frames: align on the first N associated poses (-1 all; 1: the first pose)")
+    p.add_argument("--rpg-lengths", type=float, nargs="+", metavar="M",
+                   help="rpg sub-trajectory lengths, metres (default 10, 20, 30, 40, 50 %% of the truth's path)")
+    p.add_argument("--drift-durations", type=float, nargs="+", metavar="S",
+                   help="drift per time: sub-trajectory durations, seconds (default 10 .. 50 %% of the truth's span)")
+    p.add_argument("--nees-alignment", choices=list(RPG_ALIGNMENTS), default="posyaw",
+                   help="ov_eval NEES (an estimate with covariances): the truth aligned into the estimate's frame")
     p.add_argument("--kitti-lengths", type=float, nargs="+", metavar="M",
                    help="KITTI odometry segment lengths, metres (default the devkit's 100 200 ... 800)")
     p.add_argument("--camera", help="dataset truth: only the views of this spec camera (e.g. the left camera of a "
@@ -88,7 +109,20 @@ def score(a):
     if (ek == "tum") != (gk == "tum"):
         raise InputError(f"{a.est if ek == 'tum' else a.gt}: a TUM trajectory is matched by timestamps and needs a "
                          "TUM trajectory on the other side")
-    if ek == "tum":
+    stamped = None
+    if ek == "tum" and a.association == "evo":
+        try:
+            stamped = score_stamped(est, gt, max_diff_s=a.max_time_diff, offset_s=a.t_offset,
+                                    alignment=a.rpg_alignment, n_aligned=a.rpg_n_aligned, lengths_m=a.rpg_lengths,
+                                    durations_s=a.drift_durations, nees_alignment=a.nees_alignment)
+        except InputError as exc:  # e.g. a straight truth path: rpg's alignment undetermined; APE/RPE still scored
+            stamped = f"not scored: {exc}"
+        est, gt = associated_poses(est, gt, associate_evo(gt.timestamps_s, est.timestamps_s, a.max_time_diff,
+                                                          a.t_offset))
+        matching = f"TUM timestamps within {a.max_time_diff} s, estimate shifted by {a.t_offset} s (evo)"
+    elif ek == "tum":
+        if a.t_offset:
+            raise InputError("--t-offset applies to --association evo")
         est, gt = associate(est, gt, a.max_time_diff), gt.poses
         matching = f"TUM timestamps within {a.max_time_diff} s"
     elif ek == "kitti" and gk != "kitti":
@@ -111,10 +145,13 @@ def score(a):
            "kitti_odometry": kitti_odometry(est, gt, lengths_m=a.kitti_lengths or KITTI_LENGTHS_M)}
     if ek == "colmap":
         res["colmap_reconstruction"] = colmap_model_stats(a.est)
+    if stamped is not None:
+        res["vio"] = stamped
     inputs = {"est": a.est, "gt": a.gt, "format": ek, "gt_format": gk, "matching": matching,
               "alignment": a.alignment, "delta_frames": delta if a.delta_unit == "f" else None, "camera": a.camera,
               "delta": delta, "delta_unit": a.delta_unit, "all_pairs": a.all_pairs, "n_to_align": a.n_to_align,
-              "rpe_gaps": a.rpe_gaps,
+              "rpe_gaps": a.rpe_gaps, "association": a.association if ek == "tum" else None,
+              "t_offset": a.t_offset if ek == "tum" else None,
               "kitti_convention": a.kitti_convention if "kitti" in (ek, gk) else None}
 
     def figures():

@@ -46,6 +46,8 @@ COMMANDS: tuple[Command, ...] = (
                         "outlier fractions drawn from DATASET's exact truth (docs/fmatrix_survey.md, docs/sweeps.md)."),
     Command("homography", "homography: mean corner error, accuracy and AUC", "twoview"),
     Command("calibration", "intrinsics: fx/fy/cx/cy errors, projection difference field, reprojection RMS", "camera"),
+    Command("cam-imu", "camera-IMU calibration (Kalibr camchain-imucam.yaml): extrinsic rotation and translation, "
+                       "time offset against the truth", "cam_imu"),
     Command("pnp", "absolute pose: rotation angle, translation error, reprojection RMS", "camera"),
     Command("features", "keypoints and matches: repeatability, MMA@1..10, matching score, precision and recall "
                         "per image pair and series", "features"),

@@ -23,6 +23,7 @@ from recon_eval.metrics.poses import Poses
 from recon_eval.readers.colmap_binary import read_colmap_binary
 from recon_eval.readers.colmap_text import read_colmap_text
 from recon_eval.readers.exr import read_exr_map
+from recon_eval.readers.euroc import is_euroc_groundtruth, read_euroc_groundtruth
 from recon_eval.readers.kitti_odometry import read_kitti_poses
 from recon_eval.readers.kitti_png import read_kitti_disparity
 from recon_eval.readers.nerf import read_nerf_transforms
@@ -79,14 +80,16 @@ def read_image(path) -> np.ndarray:
 
 # --- poses -------------------------------------------------------------------------------------
 def sniff_trajectory(path: Path) -> str:
-    """'tum' (8 numbers per line) or 'kitti' (12), from the first non-comment line."""
+    """'tum' (8 numbers per line, or ov_eval's 20 with covariances) or 'kitti' (12), from the first
+    non-comment line."""
     for ln in read_text(path, "a TUM or KITTI trajectory").splitlines():
         ln = ln.split("#", 1)[0].replace(",", " ").strip()
         if ln:
             n = len(ln.split())
-            if n in (8, 12):
-                return "tum" if n == 8 else "kitti"
-            raise InputError(f"{path}:1: expected 8 (TUM) or 12 (KITTI odometry) numbers per line, got {n}")
+            if n in (8, 12, 20):
+                return "kitti" if n == 12 else "tum"
+            raise InputError(f"{path}:1: expected 8 (TUM) or 12 (KITTI odometry) numbers per line, got {n} "
+                             "(20: TUM with ov_eval's covariances)")
     raise InputError(f"{path}: empty trajectory (expected TUM or KITTI lines)")
 
 
@@ -126,6 +129,7 @@ POSE_FORMATS = (
                lambda p, camera, conv: read_colmap_text(p).poses),
     PoseFormat("nerf", lambda p: p.is_file() and p.suffix.lower() == ".json",
                lambda p, camera, conv: read_nerf_transforms(p).poses),
+    PoseFormat("tum", is_euroc_groundtruth, lambda p, camera, conv: read_euroc_groundtruth(p)),  # stamped, as TUM
     PoseFormat("tum", lambda p: p.is_file() and sniff_trajectory(p) == "tum", lambda p, camera, conv: read_tum(p)),
     PoseFormat("kitti", lambda p: p.is_file() and sniff_trajectory(p) == "kitti",
                lambda p, camera, conv: read_kitti_poses(p, conv)),

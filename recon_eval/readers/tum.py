@@ -3,6 +3,11 @@
 Each line is the pose of the camera in the world (world_from_cam; quaternion *scalar last*). The
 reader converts to cam_from_world and assumes OpenCV camera axes. Poses are named by their
 timestamp string; :func:`associate` matches two trajectories by nearest timestamps.
+
+OpenVINS's ov_eval writes the same lines followed by the upper triangles of the orientation and
+position covariances, 20 numbers (``... qw Pr11 Pr12 Pr13 Pr22 Pr23 Pr33 Pt11 Pt12 Pt13 Pt22 Pt23
+Pt33``, ov_eval ``Loader::load_data``); those are kept as ``cov_ori`` (rad^2) and ``cov_pos``
+(m^2), for NEES (:mod:`recon_eval.metrics.nees`). Every line of a file has the same count.
 """
 from __future__ import annotations
 
@@ -12,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from recon_eval.errors import InputError
+from recon_eval.metrics.nees import covariances_from_upper
 from recon_eval.metrics.poses import Poses
 from recon_eval.readers.text import read_text
 from scenegen.geometry.rotation import matrix_from_quat_wxyz
@@ -21,6 +27,8 @@ from scenegen.geometry.rotation import matrix_from_quat_wxyz
 class TumTrajectory:
     timestamps_s: np.ndarray  # (N,)
     poses: Poses  # cam_from_world, names = "%.6f" % timestamp
+    cov_ori: np.ndarray | None = None  # (N, 3, 3) rad^2, ov_eval's 20-number lines only
+    cov_pos: np.ndarray | None = None  # (N, 3, 3) m^2
 
 
 def read_tum(path) -> TumTrajectory:
@@ -33,13 +41,15 @@ def read_tum(path) -> TumTrajectory:
         if not ln:
             continue
         tok = ln.split()
-        if len(tok) != 8:
-            raise InputError(f"{p}:{k}: expected 8 numbers (timestamp tx ty tz qx qy qz qw), got {len(tok)}")
+        if len(tok) not in (8, 20) or (rows and len(tok) != len(rows[0])):
+            want = (f"{len(rows[0])} numbers as the lines above" if rows
+                    else "8 numbers (timestamp tx ty tz qx qy qz qw)")
+            raise InputError(f"{p}:{k}: expected {want} (or ov_eval's 20 with covariances), got {len(tok)}")
         try:
             rows.append([float(v) for v in tok])
         except ValueError:
             raise InputError(f"{p}:{k}: not numbers: {ln!r}") from None
-    a = np.asarray(rows, dtype=np.float64).reshape(-1, 8)
+    a = np.asarray(rows, dtype=np.float64).reshape(-1, len(rows[0]) if rows else 8)
     if not np.all(np.isfinite(a)) or (len(a) and not np.all(np.linalg.norm(a[:, 4:8], axis=1) > 0)):
         raise InputError(f"{p}: non-finite values or zero quaternions")
     q_wxyz = a[:, [7, 4, 5, 6]]
@@ -47,6 +57,9 @@ def read_tum(path) -> TumTrajectory:
     R_cw = np.swapaxes(R_wc, 1, 2)
     t_cw = -np.einsum("nij,nj->ni", R_cw, a[:, 1:4])
     names = tuple(f"{t:.6f}" for t in a[:, 0])
+    if a.shape[1] == 20:
+        return TumTrajectory(a[:, 0].copy(), Poses(names, R_cw, t_cw), covariances_from_upper(a[:, 8:14]),
+                             covariances_from_upper(a[:, 14:20]))
     return TumTrajectory(a[:, 0].copy(), Poses(names, R_cw, t_cw))
 
 

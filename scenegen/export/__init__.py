@@ -8,6 +8,8 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``gaussian-splatting``: 3DGS scene folder (undistorted PINHOLE images/, sparse/0/);
 * ``nerf``: instant-ngp / nerfstudio ``transforms.json`` + images/, depth/, masks/, a split;
 * ``kitti-stereo``: KITTI 2015 stereo layout from the rectified stereo frames (calib, obj_map);
+* ``kitti-odometry``: KITTI odometry layout (image_0..3, calib.txt, times.txt, poses/00.txt) from
+  one rig's rectified stereo frames;
 * ``middlebury``: MiddEval3 folders (im0/im1.png, disp0GT/disp1GT.pfm, mask0nocc.png, calib.txt);
 * ``opencv``: cv2.FileStorage YAML (K, D, R, T per view; K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q per
   stereo frame; R T E F per cross-view pair);
@@ -34,6 +36,7 @@ from scenegen.export import (
     euroc,
     gaussian_splatting,
     kitti_flow,
+    kitti_odometry,
     kitti_sceneflow,
     kitti_stereo,
     lidar,
@@ -55,14 +58,15 @@ FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.exp
            "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
            "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
            "euroc": euroc.export, "kitti-velodyne": lidar.export_kitti, "nuscenes-lidar": lidar.export_nuscenes,
-           "lidar-pcd": lidar.export_pcd, "lidar-ply": lidar.export_ply}
+           "lidar-pcd": lidar.export_pcd, "lidar-ply": lidar.export_ply,
+           "kitti-odometry": kitti_odometry.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
                   "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
                   "euroc": "views", "kitti-velodyne": "sweeps", "nuscenes-lidar": "sweeps", "lidar-pcd": "sweeps",
-                  "lidar-ply": "sweeps"}
+                  "lidar-ply": "sweeps", "kitti-odometry": "stereo frames"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

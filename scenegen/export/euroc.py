@@ -16,6 +16,8 @@ world (Z-up, OpenCV camera axes for the cameras).
   (the IMU origin in the world), ``q_RS`` (world_from_imu, w first), ``v_RS_R`` (world frame) and
   the biases in the measurements ``b_w_RS_S``, ``b_a_RS_S`` (IMU frame).
 * ``camchain.yaml`` and ``imu.yaml``: Kalibr's files for the same rig.
+* ``orbslam3.yaml`` and ``openvins/``: ORB-SLAM3's and OpenVINS's settings with the same true
+  calibration (:mod:`scenegen.export.vio_settings`).
 """
 from __future__ import annotations
 
@@ -24,6 +26,7 @@ from scenegen.export.common import fmt, write
 from scenegen.export.errors import ExportError
 from scenegen.export.euroc_calib import camchain_yaml, camera_sensor_yaml, imu_sensor_yaml, kalibr_imu_yaml
 from scenegen.export.euroc_rig import ns, vio_rig
+from scenegen.export.vio_settings import openvins_files, orbslam3_yaml
 from scenegen.geometry.color import to_uint8
 
 IMU_HEAD = ("#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
@@ -55,6 +58,10 @@ def export(ds, dest, progress=None) -> dict:
              for k, cam in enumerate(rig.cameras)}  # refused before any image is written
     calib.update({"mav0/imu0/sensor.yaml": imu_sensor_yaml(rig), "camchain.yaml": camchain_yaml(rig, root),
                   "imu.yaml": kalibr_imu_yaml(rig)})
+    orbslam3, orbslam3_note = orbslam3_yaml(rig, root)
+    if orbslam3 is not None:
+        calib["orbslam3.yaml"] = orbslam3
+    calib.update(openvins_files(rig, root))
     imu_stamps = _stamps(s.field("stamp_s"), f"the IMU stream {s.name!r}", root)
     true_stamps = _stamps(s.time_s, f"the IMU stream {s.name!r}", root)
     total, done = sum(len(c.views) for c in rig.cameras), 0
@@ -76,4 +83,5 @@ def export(ds, dest, progress=None) -> dict:
         write(dest, rel, data)
     return {"files": files + 2 + len(calib), "rig": rig.rig, "imu_stream": s.name, "imu_samples": s.samples,
             "cameras": {f"cam{k}": c.member for k, c in enumerate(rig.cameras)},
-            "frames": len(rig.cameras[0].views), "timeshift_cam_imu_s": 0.0 - rig.time_offset_s}
+            "frames": len(rig.cameras[0].views), "timeshift_cam_imu_s": 0.0 - rig.time_offset_s,
+            "orbslam3": orbslam3_note}

@@ -7,12 +7,14 @@ from scenegen.spec.sensors.camera import CAMERA
 from scenegen.spec.sensors.imu import IMU
 from scenegen.spec.sensors.kind import SensorKind
 from scenegen.spec.sensors.lidar import LIDAR
+from scenegen.spec.sensors.wheel_odometry import WHEEL_ODOMETRY
 
 #: Sensor kind name -> SensorKind (a rig member's default kind: RigMember.kind, the camera).
 SENSOR_KINDS: dict[str, SensorKind] = {
     CAMERA.name: CAMERA,
     IMU.name: IMU,
     LIDAR.name: LIDAR,
+    WHEEL_ODOMETRY.name: WHEEL_ODOMETRY,
 }
 
 

@@ -82,7 +82,12 @@ class TestPoses:
         (tmp_path / "tum.txt").write_text("# comment\n1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n")
         kind, traj = read_poses(tmp_path / "tum.txt")
         assert kind == "tum" and list(traj.timestamps_s) == [1.0, 2.0]
-        assert [f.kind for f in POSE_FORMATS] == ["dataset", "colmap", "colmap", "nerf", "tum", "kitti"]
+        (tmp_path / "data.csv").write_text("#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], "
+                                           "q_RS_x [], q_RS_y [], q_RS_z []\n1000000000,0,0,0,1,0,0,0\n"
+                                           "1500000000,1,0,0,1,0,0,0\n")
+        kind, traj = read_poses(tmp_path / "data.csv")  # EuRoC ground truth: stamped, as TUM
+        assert kind == "tum" and list(traj.timestamps_s) == [1.0, 1.5]
+        assert [f.kind for f in POSE_FORMATS] == ["dataset", "colmap", "colmap", "nerf", "tum", "tum", "kitti"]
 
     def test_dataset_camera_subset(self, plane_dataset):
         kind, P = read_poses(plane_dataset[0], camera="left")

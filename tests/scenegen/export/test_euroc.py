@@ -1,7 +1,8 @@
 """The EuRoC MAV export (scenegen.export.euroc) read back by a reader written here from the
 formats' documentation (EuRoC's ASL dataset format: csv + sensor.yaml; Kalibr's wiki, "YAML
 formats"), with csv, PyYAML and SciPy's rotations, not our code: a two-camera rig with a
-distorting camera and an IMU, 32x24, three frames; and the refusals."""
+distorting camera and an IMU, 32x24, three frames; and the refusals. evo reads the trajectories we
+write (TUM export, KITTI poses, EuRoC ground truth) and gives recon-eval's APE."""
 from __future__ import annotations
 
 import csv
@@ -9,11 +10,18 @@ import json
 import sys
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 import yaml
+from evo.core import metrics, sync
+from evo.core.trajectory import PosePath3D, PoseTrajectory3D
+from evo.tools import file_interface
 from scipy.spatial.transform import Rotation
 
+from recon_eval.cli import main as recon_eval
+from recon_eval.readers.kitti_odometry import write_kitti_poses
+from recon_eval.readers.registry import read_poses
 from scenegen.cli import main
 from scenegen.dataset import Dataset
 from scenegen.export.errors import ExportError
@@ -173,3 +181,112 @@ def test_one_camera_and_an_imu_clock_behind_the_rig(tmp_path):
     truth = [int(r[0]) for r in read_csv(mav / "state_groundtruth_estimate0" / "data.csv")[1]]
     assert len(imu) == len(truth) == 41 and [t + shift_ns for t in truth] == imu
     assert imu[0] == 0 and truth[0] == 5_000_000
+
+
+def _evo_ape_rmse(ref, est, *, align: bool, max_diff=0.01):
+    if max_diff is not None:
+        ref, est = sync.associate_trajectories(ref, est, max_diff=max_diff)
+    if align:
+        est.align(ref)
+    ape = metrics.APE(metrics.PoseRelation.translation_part)
+    ape.process_data((ref, est))
+    return ape.get_statistic(metrics.StatisticsType.rmse), ref.num_poses
+
+
+def _noisy(traj, seed, every=1):
+    rng = np.random.default_rng(seed)
+    ids = list(range(0, traj.num_poses, every))
+    p = traj.positions_xyz[ids] + rng.normal(0, 0.01, (len(ids), 3))
+    q = traj.orientations_quat_wxyz[ids]
+    if isinstance(traj, PoseTrajectory3D):
+        return PoseTrajectory3D(positions_xyz=p, orientations_quat_wxyz=q, timestamps=traj.timestamps[ids])
+    return PosePath3D(positions_xyz=p, orientations_quat_wxyz=q)
+
+
+@pytest.mark.render
+def test_evo_reads_our_tum_kitti_and_euroc_trajectories_and_gives_recon_evals_ape(exported, tmp_path):
+    """evo's readers on the TUM export, a KITTI file recon_eval writes and the EuRoC ground truth:
+    the stamps are the views' times (TUM: time_s, not frame indices), the positions the truth,
+    and evo's APE of an estimate (written by evo) equals ``recon-eval poses``'s."""
+    out, dest = exported
+    cams = json.loads((out / "cameras.json").read_text())
+    left = [v for v in cams["view_order"] if cams["views"][v]["rig_member"] == "left"]
+    centres = np.array([-np.array(cams["views"][v]["cam_from_world"]["R"]).T @ cams["views"][v]["cam_from_world"]["t"]
+                        for v in left])
+    assert main(["export", str(out), "--format", "tum", "-o", str(tmp_path / "tum")]) == 0
+    tum = file_interface.read_tum_trajectory_file(str(tmp_path / "tum" / "r_left.txt"))
+    assert tum.timestamps.tolist() == [cams["views"][v]["time_s"] for v in left] == [0.0, 0.1, 0.2]
+    assert np.abs(tum.positions_xyz - centres).max() < 1e-12
+    _, poses = read_poses(out, camera="cam")
+    left_poses = type(poses)(tuple(left), poses.R_cam_from_world[[poses.names.index(v) for v in left]],
+                             poses.t_cam_from_world[[poses.names.index(v) for v in left]])
+    write_kitti_poses(tmp_path / "gt_kitti.txt", left_poses)
+    kitti = file_interface.read_kitti_poses_file(str(tmp_path / "gt_kitti.txt"))
+    assert np.abs(kitti.positions_xyz - centres).max() < 1e-12
+    euroc = file_interface.read_euroc_csv_trajectory(str(dest / "mav0" / "state_groundtruth_estimate0" / "data.csv"))
+    assert euroc.num_poses == 41 and euroc.timestamps[-1] == pytest.approx(0.2)
+
+    worst = 0.0
+    cases = [("tum", tum, file_interface.write_tum_trajectory_file, tmp_path / "tum" / "r_left.txt", False, 1),
+             ("kitti", kitti, file_interface.write_kitti_poses_file, tmp_path / "gt_kitti.txt", False, 1),
+             ("euroc", euroc, file_interface.write_tum_trajectory_file,
+              dest / "mav0" / "state_groundtruth_estimate0" / "data.csv", True, 4)]
+    for k, (what, ref, write_est, gt_file, align, every) in enumerate(cases):
+        est = _noisy(ref, k, every)
+        est_file = tmp_path / f"est_{what}.txt"
+        write_est(str(est_file), est)
+        rmse, n = _evo_ape_rmse(ref, est, align=align, max_diff=None if what == "kitti" else 0.01)
+        report = tmp_path / f"{what}.json"
+        assert recon_eval(["poses", str(est_file), str(gt_file), "--alignment", "se3" if align else "none",
+                           "--json", str(report), "--quiet"]) == 0
+        ape = json.loads(report.read_text())["results"]["ape"]
+        assert ape["n_registered"] == n and (what != "euroc" or n == 11)
+        worst = max(worst, abs(ape["trans_stats_m"]["rmse"] - rmse))
+    assert worst < 1e-12
+    print(f"evo vs recon-eval APE rmse on TUM / KITTI / EuRoC files: max difference {worst:.1e} m")
+
+
+def _fs_matrix(node) -> np.ndarray:
+    """A FileStorage node: an ``!!opencv-matrix`` or a sequence of rows."""
+    if node.isSeq():
+        return np.array([[node.at(i).at(j).real() for j in range(node.at(i).size())] for i in range(node.size())])
+    return node.mat().astype(np.float64)
+
+
+@pytest.mark.render
+def test_orbslam3_and_openvins_settings_load_in_opencv_with_the_true_calibration(exported):
+    """ORB-SLAM3 and OpenVINS read their settings with cv::FileStorage: so do we here (cv2), and
+    compare every calibration value with EuRoC's sensor.yaml files (read with PyYAML)."""
+    _, dest = exported
+    sensors = [yaml.safe_load((dest / "mav0" / f"cam{k}" / "sensor.yaml").read_text()) for k in (0, 1)]
+    imu = yaml.safe_load((dest / "mav0" / "imu0" / "sensor.yaml").read_text())
+    T_BS = [matrix(s["T_BS"]["data"]) for s in sensors]
+    fs = cv2.FileStorage(str(dest / "orbslam3.yaml"), cv2.FILE_STORAGE_READ)
+    assert fs.isOpened() and fs.getNode("File.version").string() == "1.0"
+    assert fs.getNode("Camera.type").string() == "PinHole"
+    for k, s in enumerate(sensors, start=1):
+        got = [fs.getNode(f"Camera{k}.{n}").real() for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2")]
+        assert got == s["intrinsics"] + s["distortion_coefficients"]
+    assert (fs.getNode("Camera.width").real(), fs.getNode("Camera.height").real()) == (32, 24)
+    assert fs.getNode("Camera.fps").real() == 10.0
+    # dt: f, as ORB-SLAM3's own files: float32 of the truth
+    assert np.abs(_fs_matrix(fs.getNode("IMU.T_b_c1")) - T_BS[0]).max() < 1e-7
+    assert np.abs(_fs_matrix(fs.getNode("Stereo.T_c1_c2")) - np.linalg.inv(T_BS[0]) @ T_BS[1]).max() < 1e-7
+    assert fs.getNode("IMU.NoiseGyro").real() == imu["gyroscope_noise_density"] == 0.001
+    assert fs.getNode("IMU.AccWalk").real() == imu["accelerometer_random_walk"]
+    assert fs.getNode("IMU.Frequency").real() == 200.0
+    ov = cv2.FileStorage(str(dest / "openvins" / "kalibr_imucam_chain.yaml"), cv2.FILE_STORAGE_READ)
+    for k, s in enumerate(sensors):
+        cam = ov.getNode(f"cam{k}")
+        assert np.array_equal(_fs_matrix(cam.getNode("T_imu_cam")), T_BS[k])
+        assert [cam.getNode("intrinsics").at(i).real() for i in range(4)] == s["intrinsics"]
+        assert [cam.getNode("distortion_coeffs").at(i).real() for i in range(4)] == s["distortion_coefficients"]
+        assert cam.getNode("distortion_model").string() == "radtan" and cam.getNode("timeshift_cam_imu").real() == 0
+        assert cam.getNode("cam_overlaps").at(0).real() == 1 - k
+    imu_chain = cv2.FileStorage(str(dest / "openvins" / "kalibr_imu_chain.yaml"), cv2.FILE_STORAGE_READ)
+    oi = imu_chain.getNode("imu0")  # the FileStorage must outlive its nodes
+    assert oi.getNode("gyroscope_noise_density").real() == 0.001 and oi.getNode("update_rate").real() == 200.0
+    assert oi.getNode("model").string() == "kalibr" and np.array_equal(_fs_matrix(oi.getNode("Tg")), np.zeros((3, 3)))
+    est = cv2.FileStorage(str(dest / "openvins" / "estimator_config.yaml"), cv2.FILE_STORAGE_READ)
+    assert est.getNode("max_cameras").real() == 2 and est.getNode("gravity_mag").real() == 9.80665
+    assert est.getNode("relative_config_imucam").string() == "kalibr_imucam_chain.yaml"

@@ -1,7 +1,8 @@
 """Exports loaded the way their consumers load them: pycolmap for the COLMAP and 3D Gaussian
 Splatting models (with 3DGS's own camera rules), nerfstudio's / instant-ngp's transforms.json
 rules written out here, pykitti's calib parser, the MiddEval3 SDK's names, TUM RGB-D's layout,
-OpenCV's EXR reader for the rectification maps; a refused export leaves no folder behind."""
+OpenCV's EXR reader for the rectification maps, the KITTI odometry devkit's files and evo's KITTI
+reader; a refused export leaves no folder behind."""
 import json
 import math
 import os
@@ -11,6 +12,7 @@ import sys
 import cv2
 import numpy as np
 import pytest
+from evo.tools import file_interface
 
 from scenegen.cli import main
 from scenegen.dataset import Dataset
@@ -309,3 +311,42 @@ def test_refused_export_leaves_no_folder(ds, tmp_path, capsys, monkeypatch):
     monkeypatch.undo()
     assert main(["export", str(ds.root), "--format", "nerf", "-o", str(dest)]) == 0  # not blocked
     assert (dest / "transforms.json").is_file()
+
+
+def test_kitti_odometry_layout_read_as_the_devkit_and_evo_read_it(ds, tmp_path):
+    """KITTI odometry (devkit readme: calib.txt ``P0..P3``, ``Tr``, 12 numbers each; poses/XX.txt
+    world_from_cam0 with the world cam0 at frame 0; times.txt seconds), read here with plain
+    numpy and with evo's KITTI reader."""
+    dest = run_export(ds, "kitti-odometry", tmp_path)
+    seq = dest / "sequences" / "00"
+    calib = {}
+    for ln in (seq / "calib.txt").read_text().splitlines():
+        key, vals = ln.split(":", 1)
+        calib[key] = np.array([float(x) for x in vals.split()]).reshape(3, 4)
+    assert sorted(calib) == ["P0", "P1", "P2", "P3", "Tr"] and np.array_equal(calib["Tr"], np.eye(4)[:3])
+    frames = ds.crossview.stereo_frames()
+    c = json.loads(ds.path(stereo_path(frames[0].left_view, "calib")).read_text())
+    assert np.array_equal(calib["P0"], calib["P2"]) and np.array_equal(calib["P1"], calib["P3"])
+    assert np.allclose(calib["P0"], c["P1"], rtol=1e-12) and np.allclose(calib["P1"], c["P2"], rtol=1e-12)
+    f = calib["P0"][0, 0]
+    assert abs(-calib["P1"][0, 3] / f - 0.12) < 1e-9  # the rig's 0.12 m baseline
+    assert [float(x) for x in (seq / "times.txt").read_text().split()] == [0.0, 1.0]  # static: the frame index
+    for k, fr in enumerate(frames):
+        for folder, shape in (("image_0", (150, 200)), ("image_1", (150, 200)), ("image_2", (150, 200, 3)),
+                              ("image_3", (150, 200, 3))):
+            assert cv2.imread(str(seq / folder / f"{k:06d}.png"), cv2.IMREAD_UNCHANGED).shape == shape
+    # the poses: the left rectified camera (R1 after the raw pose) relative to frame 0
+    rect = []
+    for fr in frames:
+        cf = json.loads(ds.path(stereo_path(fr.left_view, "calib")).read_text())
+        raw = ds.camera(fr.left_view)[1]
+        R = np.array(cf["R1"]) @ raw.R
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R.T, -R.T @ (np.array(cf["R1"]) @ raw.t)  # world_from_rect
+        rect.append(T)
+    want = [np.linalg.inv(rect[0]) @ T for T in rect]
+    lines = np.loadtxt(dest / "poses" / "00.txt").reshape(-1, 3, 4)
+    assert np.array_equal(lines[0], np.eye(4)[:3]) or np.abs(lines[0] - np.eye(4)[:3]).max() < 1e-15
+    assert np.abs(lines - np.array(want)[:, :3]).max() < 1e-12
+    evo_traj = file_interface.read_kitti_poses_file(str(dest / "poses" / "00.txt"))
+    assert np.abs(evo_traj.positions_xyz - np.array(want)[:, :3, 3]).max() < 1e-12

@@ -26,6 +26,7 @@ from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
 from scenegen.spec.sensors.lidar import LidarSpec
+from scenegen.spec.sensors.wheel_odometry import WheelOdometrySpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -204,6 +205,10 @@ CASES += [(LidarSpec, key, "lidars:\n  l0: {elevations_deg: [0]}\n",
                              ("divergence_mrad", 1.0), ("footprint_rays", 3), ("return_mode", "last"),
                              ("range_noise_m", 0.1), ("reflectivity", 0.3), ("attenuation_per_m", 0.01),
                              ("min_intensity", 0.1), ("max_incidence_deg", 80.0), ("dropout_rate", 0.1))]
+CASES += [(WheelOdometrySpec, key, "wheel_odometry:\n  w: {}\n",
+           lambda s, key=key: getattr(s.sensors["wheel_odometry"]["w"], key), other)
+          for key, other in [("rate_hz", 20.0), ("wheel_radius_m", 0.2), ("track_width_m", 0.3), ("slip_left", 0.1),
+                             ("slip_right", 0.1), ("wheel_speed_noise_rad_s", 0.5)]]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
