@@ -15,8 +15,8 @@ through the same sum: both are physics of the rendered light transport, not adde
 Per pixel, the outputs are Monte Carlo means over the pixel's rays (units of the rendered
 radiance for a unit-intensity source: a white Lambertian surface facing the camera at 1 m gives
 ``dc = 1 / pi``): ``dc`` (S0), ``cos_<k>`` / ``sin_<k>`` (Re / Im of the phasor at frequency k),
-the same of the direct (one-vertex) light alone (``direct_*``), and the first-hit range spread
-over the pixel's rays (``hit_fraction``, ``range_min``, ``range_max``: the flying-pixel truth).
+the same of the direct (one-vertex) light alone (``direct_*``), and the fraction of the pixel's
+rays that meet a surface (``hit_fraction``).
 The colour of a material is reduced to the mean of its R, G, B transport (the reflectance at the
 emitter's wavelength is a model). Delta (mirror, glass) vertices cannot reach a point emitter by
 next-event estimation, so paths through them carry no ToF signal: a stated limitation.
@@ -69,13 +69,7 @@ def tof_pass(scene, camera: Camera, cam_from_world: Rigid3, freqs_hz, *, spp: in
     out = {}
     for key in parts[0]:
         a = np.concatenate([p[key] for p in parts]).reshape(H, W, spp)
-        if key == "range_min":
-            out[key] = np.min(a, axis=-1)
-        elif key == "range_max":
-            out[key] = np.max(np.where(np.isfinite(a), a, -np.inf), axis=-1)
-            out[key] = np.where(np.isfinite(out[key]), out[key], np.inf)
-        else:
-            out[key] = a.mean(axis=-1)
+        out[key] = a.mean(axis=-1)
     return out
 
 
@@ -103,13 +97,13 @@ def _trace(scene, centre_world, d_world, freqs, max_bounces: int, seed: int) -> 
     throughput = mi.Spectrum(1.0)
     length = dr.zeros(mi.Float64, n)  # camera-side optical length so far, metres
     active = dr.full(mi.Bool, True, n)
-    first_range = None
+    hit = None
     for bounce in range(max_bounces):
         si = scene.ray_intersect(ray, active)
         active &= si.is_valid()
         length += mi.Float64(dr.select(active, si.t, 0.0))
         if bounce == 0:
-            first_range = dr.select(active, mi.Float64(si.t), dr.inf)
+            hit = mi.Float64(dr.select(active, 1.0, 0.0))
         to_c = c - si.p
         dist = dr.norm(to_c)
         wo = to_c / dist
@@ -130,7 +124,6 @@ def _trace(scene, centre_world, d_world, freqs, max_bounces: int, seed: int) -> 
             active &= (bs.pdf > 0) & (dr.max(throughput) > 0)
             ray = si.spawn_ray(si.to_world(bs.wo))
         dr.eval(throughput, length, active, ray, *acc.values())
-    hit = first_range < dr.inf
-    outs = dict(acc, range_min=first_range, range_max=first_range, hit_fraction=mi.Float64(dr.select(hit, 1.0, 0.0)))
+    outs = dict(acc, hit_fraction=hit)
     dr.eval(*outs.values())
     return {k: np.array(v, dtype=np.float64) for k, v in outs.items()}

@@ -58,7 +58,7 @@ class TofSpec:
     full_well_e: float = param(60000.0, unit="e-", lo=1)
     adc_bits: int = param(16, unit="bits", lo=1, hi=16)
     min_amplitude_e: float = param(20.0, unit="e-", lo=0)  # a valid pixel's smallest amplitude
-    flying_threshold_m: float = param(0.05, unit="m", lo=0, lo_open=True)  # range spread of a flying pixel
+    flying_threshold_m: float = param(0.05, unit="m", lo=0, lo_open=True)  # a flying pixel's mixing error
     seed: int = param(0, unit="seed", label="", lo=0, hi=SEED_MAX, derived="seed32(scene seed, field path)")
     where: Where | None = where_field()
 
@@ -119,8 +119,8 @@ def tof_fields(width: int, height: int, n_freqs: int) -> tuple[StreamField, ...]
                     "that of the direct light (NaN: no direct light)"),
         StreamField("mixing_error_m", "float32", hw, "m", "truth: noise-free decoding of the direct light minus "
                     "range_true_m (a flying pixel's error; NaN: no direct light or no surface at the centre)"),
-        StreamField("flying", "bool", hw, "", "truth: the pixel's rays hit and missed, or their first-hit ranges "
-                    "span more than flying_threshold_m"),
+        StreamField("flying", "bool", hw, "", "truth: a mixed return: the pixel has direct light but its centre "
+                    "sees no surface, or |mixing_error_m| > flying_threshold_m"),
         StreamField("incidence_deg", "float32", hw, "deg", "truth: angle between the ray and the surface "
                     "normal at the centre hit (NaN: none)"),
         StreamField("world_from_sensor", "float64", (4, 4), "m", "the sensor's pose at the sample time"),
@@ -144,9 +144,6 @@ def tof_frame(scene, tof: TofSpec, cam_from_world, time_s: float, frame_seed: in
     rays = np.asarray(scene.camera_rays(camera)).reshape(camera.height, camera.width, 3)
     r_true = np.asarray(truth[TruthKind.RANGE], np.float64)
     multipath, mixing = truth_errors(sums, r_true, p, tof.max_range_m)
-    hit = sums["hit_fraction"]
-    with np.errstate(invalid="ignore"):  # inf - inf where no ray hit
-        spread = np.where(hit == 1, sums["range_max"] - sums["range_min"], 0.0)
     n = np.asarray(truth[TruthKind.NORMALS_CAM], np.float64)
     cos_inc = np.abs(np.sum(n * rays, axis=-1))
     return {
@@ -156,7 +153,7 @@ def tof_frame(scene, tof: TofSpec, cam_from_world, time_s: float, frame_seed: in
         "range_true_m": r_true, "depth_true_m": truth[TruthKind.DEPTH_Z],
         "wrap_count": np.stack([g.wrap_count(r_true, f) for f in p.freqs_hz], axis=-1).astype(np.int32),
         "multipath_error_m": multipath, "mixing_error_m": mixing,
-        "flying": ((hit > 0) & (hit < 1)) | (spread > tof.flying_threshold_m),
+        "flying": (sums["direct_dc"] > 0) & (~np.isfinite(r_true) | (np.abs(np.nan_to_num(mixing)) > tof.flying_threshold_m)),
         "incidence_deg": np.degrees(np.arccos(np.clip(cos_inc, 0.0, 1.0))),
         "world_from_sensor": cam_from_world.inverse().matrix,
     }

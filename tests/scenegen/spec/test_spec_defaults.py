@@ -25,6 +25,7 @@ from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_field
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
+from scenegen.spec.sensors.tof import TofSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -197,6 +198,13 @@ CASES += [
      lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
     (ImuSpec, "rate_hz", "imus:\n  imu0: {}\n", lambda s: s.sensors["imu"]["imu0"].rate_hz, 100.0),
 ]
+TOF = "cameras:\n  ir: {size: [32, 24], fx: 30}\ntof_cameras:\n  t: {camera: ir}\n"
+CASES += [(TofSpec, k, TOF, lambda s, k=k: getattr(s.sensors["tof"]["t"], k), v)
+          for k, v in (("frequency_mhz", 20.0), ("spp", 4), ("max_bounces", 1), ("pixel_centre_rays", True),
+                       ("integration_s", 0.002), ("signal_e_per_s_at_1m", 1e5), ("ambient_e_per_s", 10.0),
+                       ("contrast", 0.5), ("noise", False), ("read_noise_e", 1.0), ("gain_dn_per_e", 0.5),
+                       ("full_well_e", 1000.0), ("adc_bits", 12), ("min_amplitude_e", 5.0),
+                       ("flying_threshold_m", 0.1))]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
