@@ -97,7 +97,7 @@ def unwrap_two(r1_m, r2_m, f1_hz: float, f2_hz: float, max_range_m: float | None
     r1, r2 = np.asarray(r1_m, np.float64), np.asarray(r2_m, np.float64)
     R1, R2 = ambiguity_range_m(f1_hz), ambiguity_range_m(f2_hz)
     top = unambiguous_range_two_m(f1_hz, f2_hz) if max_range_m is None else float(max_range_m)
-    n1s = np.arange(int(math.ceil(top / R1)), dtype=np.float64)
+    n1s = np.arange(int(math.ceil(top / R1 - 1e-9)), dtype=np.float64)  # not R1 x (1 + eps) beyond the top
     c1 = r1[..., None] + n1s * R1  # (..., K) candidate ranges of f1
     n2 = np.maximum(np.round((c1 - r2[..., None]) / R2), 0.0)
     err = np.abs(c1 - (r2[..., None] + n2 * R2))

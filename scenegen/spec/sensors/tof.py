@@ -64,7 +64,10 @@ class TofSpec:
 
     @property
     def freqs_hz(self) -> tuple[float, ...]:
-        return (self.frequency_mhz * MHZ,) + (() if self.frequency2_mhz is None else (self.frequency2_mhz * MHZ,))
+        """The modulation frequencies in Hz (a pair: whole hertz, as the parser checked)."""
+        if self.frequency2_mhz is None:
+            return (self.frequency_mhz * MHZ,)
+        return (float(round(self.frequency_mhz * MHZ)), float(round(self.frequency2_mhz * MHZ)))
 
     def pixel(self) -> TofPixelParams:
         sensor = SensorParams(system_gain_dn_per_e=self.gain_dn_per_e, dark_noise_e=self.read_noise_e,
@@ -86,7 +89,7 @@ def parse_tof(node, name, ctx) -> TofSpec:
     if values["frequency2_mhz"] is not None:
         for key in ("frequency_mhz", "frequency2_mhz"):
             hz = values[key] * MHZ
-            if abs(hz - round(hz)) > 1e-6 * max(1.0, hz):
+            if abs(hz - round(hz)) > 1e-3:
                 raise f.get(key).error(f"a frequency pair must be whole hertz (their gcd sets the unwrapping range), "
                                        f"got {values[key]!r} MHz")
         if values["frequency2_mhz"] == values["frequency_mhz"]:
