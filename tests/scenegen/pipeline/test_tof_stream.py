@@ -18,12 +18,15 @@ from __future__ import annotations
 import json
 import math
 
+import cv2
 import numpy as np
+import OpenEXR
 import pytest
 from scipy import ndimage
 
 from recon_eval.cli import main as recon_main
 from scenegen.dataset import Dataset, verify
+from scenegen.export import export
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.tof import SPEED_OF_LIGHT_M_S, ambiguity_range_m
 from scenegen.pipeline.run import render_spec
@@ -224,3 +227,27 @@ def test_recon_eval_scores_the_tof_stream(sphere, tmp_path):
     sensor = json.loads((tmp_path / "b.json").read_text())["results"]["sensor"]
     assert sensor["completeness"] == 1.0 and abs(sensor["bias_m"] - 0.02) < 1e-9
     assert recon_main(["depth-sensor", str(out), "--stream", "nope", "--quiet"]) == 2
+
+
+def test_the_tof_export_writes_png16_exr_and_calibration_readable_by_their_tools(sphere, tmp_path):
+    out = sphere[1]
+    summary = export(out, "tof", tmp_path / "tof")
+    s = Dataset(out).streams["seq_dual"]
+    root = tmp_path / "tof" / "seq_dual"
+    raw = s.field("raw_dn")
+    for k in range(s.samples):
+        for i in range(2):
+            for j, psi in enumerate((0, 90, 180, 270)):
+                png = cv2.imread(str(root / "raw" / f"{k:06d}_f{i}_{psi:03d}.png"), cv2.IMREAD_UNCHANGED)
+                assert png.dtype == np.uint16 and np.array_equal(png, raw[k, :, :, i, j])
+        with OpenEXR.File(str(root / "exr" / f"{k:06d}.exr"), separate_channels=True) as f:
+            ch = {n: c.pixels for n, c in f.channels().items()}
+        assert np.array_equal(ch["raw_f1_270"], raw[k, :, :, 1, 3].astype(np.float32))
+        assert np.array_equal(ch["range_true"], s.field("range_true_m")[k], equal_nan=True)
+        assert np.array_equal(ch["flying"], s.field("flying")[k].astype(np.float32))
+    calib = json.loads((root / "calibration.json").read_text())
+    assert calib["frequencies_hz"] == [100e6, 80e6] and calib["camera"]["fx"] == 30.0
+    assert calib["ambiguity_ranges_m"][0] == ambiguity_range_m(100e6)
+    assert [f["time_s"] for f in calib["frames"]] == s.time_s.tolist()
+    # per stream: 2 frames x (4 PNGs a frequency + an EXR) + calibration; one, two and one frequencies
+    assert summary["files"] == (2 * 5 + 1) + (2 * 9 + 1) + (2 * 5 + 1)
