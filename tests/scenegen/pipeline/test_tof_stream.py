@@ -15,6 +15,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -30,7 +31,9 @@ from scenegen.export import export
 from scenegen.geometry.conventions import pixel_centers
 from scenegen.geometry.tof import SPEED_OF_LIGHT_M_S, ambiguity_range_m
 from scenegen.pipeline.run import render_spec
-from scenegen.spec import load_spec
+from scenegen.render import load_scene
+from scenegen.spec import load_spec, resolve_views
+from scenegen.spec.sensors.tof import tof_frame
 
 pytestmark = pytest.mark.render
 
@@ -251,3 +254,15 @@ def test_the_tof_export_writes_png16_exr_and_calibration_readable_by_their_tools
     assert [f["time_s"] for f in calib["frames"]] == s.time_s.tolist()
     # per stream: 2 frames x (4 PNGs a frequency + an EXR) + calibration; one, two and one frequencies
     assert summary["files"] == (2 * 5 + 1) + (2 * 9 + 1) + (2 * 5 + 1)
+
+
+def test_same_seed_same_bits(sphere):
+    """Footprint rays, bounce samples and noise are seeded: a frame twice is the same bytes, another
+    seed is not."""
+    spec = load_spec(sphere[0])
+    scene = load_scene(spec, variant="llvm_ad_rgb")
+    tof = dataclasses.replace(spec.sensors["tof"]["edges"], noise=True, max_bounces=2)
+    pose = resolve_views(spec)[0].cam_from_world
+    a, b, c = (tof_frame(scene, tof, pose, 0.0, seed) for seed in (5, 5, 6))
+    assert all(np.array_equal(a[k], b[k], equal_nan=True) for k in a)
+    assert not np.array_equal(a["raw_dn"], c["raw_dn"])
