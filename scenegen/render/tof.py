@@ -43,34 +43,31 @@ from scenegen.render.arrays import to_jit
 WAVEFRONT_RAYS = 1 << 21
 
 
-def subpixel_positions(camera: Camera, spp: int, seed: int, centre: bool) -> np.ndarray:
-    """(H*W*spp, 2) float64 OpenCV pixel positions, pixel-major (a pixel's rays together)."""
-    c = np.repeat(pixel_centers(camera.width, camera.height).reshape(-1, 2), spp, axis=0)
-    if centre:
-        return c
-    return c + np.random.default_rng(seed).uniform(-0.5, 0.5, size=c.shape)
+def subpixel_positions(pixels: np.ndarray, spp: int, rng, centre: bool) -> np.ndarray:
+    """(P*spp, 2) float64 OpenCV pixel positions of the (P, 2) pixel centres, pixel-major (a
+    pixel's rays together): the centres themselves, or uniform in each pixel's square."""
+    c = np.repeat(pixels, spp, axis=0)
+    return c if centre else c + rng.uniform(-0.5, 0.5, size=c.shape)
 
 
 def tof_pass(scene, camera: Camera, cam_from_world: Rigid3, freqs_hz, *, spp: int, seed: int,
              max_bounces: int, centre: bool = False) -> dict[str, np.ndarray]:
-    """The per-pixel path sums of the module docstring, each (H, W) float64."""
-    H, W = camera.height, camera.width
-    uv = subpixel_positions(camera, int(spp), int(seed), centre)
-    d_cam = camera.unproject_unit(uv)  # (N, 3) float64, unit
+    """The per-pixel path sums of the module docstring, each (H, W) float64. Pixels are traced in
+    blocks of at most :data:`WAVEFRONT_RAYS` rays, block b's positions and bounces seeded by
+    (seed, b), so memory stays bounded whatever the image size."""
+    H, W, spp = camera.height, camera.width, int(spp)
     world_from_cam = cam_from_world.inverse()
-    d_world = d_cam @ world_from_cam.R.T
     centre_world = np.asarray(world_from_cam.t, np.float64)
-    n = len(d_world)
+    pixels = pixel_centers(W, H).reshape(-1, 2)
+    block = max(1, WAVEFRONT_RAYS // spp)
     parts = []
-    for k, start in enumerate(range(0, n, WAVEFRONT_RAYS)):
-        sl = slice(start, min(n, start + WAVEFRONT_RAYS))
-        parts.append(_trace(scene, centre_world, d_world[sl], tuple(float(f) for f in freqs_hz),
-                            int(max_bounces), (int(seed) + k) % 2 ** 32))
-    out = {}
-    for key in parts[0]:
-        a = np.concatenate([p[key] for p in parts]).reshape(H, W, spp)
-        out[key] = a.mean(axis=-1)
-    return out
+    for b, start in enumerate(range(0, len(pixels), block)):
+        uv = subpixel_positions(pixels[start:start + block], spp, np.random.default_rng([int(seed), b]), centre)
+        d_world = camera.unproject_unit(uv) @ world_from_cam.R.T  # (N, 3) float64, unit
+        sums = _trace(scene, centre_world, d_world, tuple(float(f) for f in freqs_hz), int(max_bounces),
+                      (int(seed) * 7919 + b) % 2 ** 32)
+        parts.append({k: v.reshape(-1, spp).mean(axis=-1) for k, v in sums.items()})
+    return {k: np.concatenate([p[k] for p in parts]).reshape(H, W) for k in parts[0]}
 
 
 def _phasor_add(acc, key, contrib64, length_m, freqs):

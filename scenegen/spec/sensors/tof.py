@@ -45,7 +45,7 @@ class TofSpec:
                                          doc_default="none (one frequency: the wrapped range)")
     max_range_m: float | None = param(None, unit="m", lo=0, lo_open=True,
                                       doc_default="the frequency pair's unambiguous range c / (2 gcd(f1, f2))")
-    spp: int = param(16, unit="rays per pixel", lo=1, hi=4096)
+    spp: int = param(16, unit="rays per pixel", lo=1, hi=1024)
     max_bounces: int = param(3, unit="surface vertices of a path", lo=1, hi=16)
     pixel_centre_rays: bool = param(False, unit="flag")  # every ray through its pixel's centre: no mixed returns
     integration_s: float = param(1e-3, unit="s", lo=0, lo_open=True, hi=10.0)  # each tap's exposure
