@@ -65,6 +65,28 @@ views:
         - {time_s: 0.0, eye: [0, -3, 0], target: [0, 0, 0]}
         - {time_s: 0.1, eye: [0.2, -3.1, 0], target: [0, 0, 0]}
 """
+EDGE = """\
+name: tof_edge
+sequence: {fps: 10, frames: 2}
+objects:
+  - {name: box, shape: {type: box, size: [0.6, 0.6, 0.6]}, material: {type: diffuse, color: 0.8}}
+  - {name: wall, shape: {type: plane, size: [5, 5]}, material: {type: diffuse, color: 0.5},
+     transform: {translation: [0, 1, 0], rotation_deg: [90, 0, 0]}}
+cameras:
+  ir: {size: [32, 24], fx: 30}
+tof_cameras:
+  tof0: {camera: ir, frequency_mhz: 20, noise: false, spp: 16, max_bounces: 1}
+rigs:
+  kinect: {type: multi, members: [{kind: tof, sensor: tof0, name: depth}]}
+views:
+  - rig: kinect
+    name: seq
+    trajectory:
+      interpolation: linear
+      keyframes:
+        - {time_s: 0.0, eye: [0, -3, 0], target: [0, 0, 0]}
+        - {time_s: 0.1, eye: [0.3, -3, 0.2], target: [0, 0, 0]}
+"""
 CORNER_F_MHZ = 20.0
 RHO = 0.8
 CORNER = f"""\
@@ -106,6 +128,11 @@ def _render(tmp_path_factory, name, text):
 @pytest.fixture(scope="module")
 def sphere(tmp_path_factory):
     return _render(tmp_path_factory, "sphere", SPHERE)
+
+
+@pytest.fixture(scope="module")
+def edge(tmp_path_factory):
+    return _render(tmp_path_factory, "edge", EDGE)
 
 
 @pytest.fixture(scope="module")
@@ -291,3 +318,28 @@ def test_the_tof_dc_equals_mitsuba_s_path_tracer_with_a_point_light_at_the_centr
     # indirect light the ratio would fall by its share (10-20 % here)
     assert abs(ratio.mean() - 1) < 0.01
     assert np.median(np.abs(ratio - 1)) < 0.03
+
+
+def test_flying_pixels_at_a_depth_edge_read_between_the_two_surfaces(edge):
+    """A box 2.7 m away in front of a wall 4 m away, direct light only, rays over each pixel's
+    square: the pixels whose footprint straddles the box's outline mix the two returns, and as the
+    two phasors are 1.1 rad apart at 20 MHz (< pi) their sum's phase, so the decoded range, lies
+    strictly between the two surfaces' ranges; these are the flying pixels, all on the outline.
+    Elsewhere the reading is the mean range of the pixel's 16 uniform rays: the centre's range
+    within the sampling noise of the range's slope g (m/px) over the footprint, g / sqrt(12 x 16),
+    checked to 5 of those plus 2 mm for the second-order terms."""
+    s = Dataset(edge[1]).streams["seq_depth"]
+    for k in range(s.samples):
+        t = s.field("range_true_m")[k].astype(np.float64)
+        r = s.field("range_m")[k].astype(np.float64)
+        box = t < 3.2  # the box's faces are at 2.7-3.2 m, the wall at 4 m and beyond
+        outline = ndimage.binary_dilation(box, np.ones((3, 3))) & ~ndimage.binary_erosion(box, np.ones((3, 3)))
+        flying = s.field("flying")[k]
+        assert flying.sum() >= 10 and not (flying & ~outline).any()
+        near = ndimage.minimum_filter(t, 3)  # the nearest and farthest surface a footprint can meet
+        far = ndimage.maximum_filter(t, 3)
+        assert np.all((r[flying] > near[flying] + 0.05) & (r[flying] < far[flying] - 0.05))
+        gy, gx = np.gradient(np.where(np.isfinite(t), t, np.nan))
+        tol = 5 * np.hypot(gx, gy) / math.sqrt(12 * 16) + 2e-3
+        mixing = np.abs(s.field("mixing_error_m")[k])
+        assert np.all(mixing[~outline] < tol[~outline])
