@@ -65,6 +65,8 @@ class Caster:
         """Per-pixel path sums of a time-of-flight camera with its co-located emitter at a pose and
         time: phasors per modulation frequency, direct light alone, first-hit range spread
         (:func:`scenegen.render.tof.tof_pass`)."""
+        if mi.variant().startswith("scalar"):
+            raise NotImplementedError("a ToF camera needs a vectorised Mitsuba variant (llvm_ad_rgb / cuda_ad_rgb)")
         return tof_pass(self._at(time_s).scene, camera, cam_from_world, freqs_hz, spp=spp, seed=seed,
                         max_bounces=max_bounces, centre=centre)
 
