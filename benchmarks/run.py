@@ -16,6 +16,7 @@ BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.
            "bench_mesh_distance.py", "bench_scale.py", "bench_flow.py", "bench_stages.py",
            "bench_dask_window.py",
            "bench_lidar.py",
+           "bench_tof.py",
            )
 
 

@@ -35,6 +35,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("poses", "camera poses: APE, RPE, registration ratio, relative-pose AUC and mAA", "poses"),
     Command("disparity", "stereo disparity: KITTI D1, Middlebury, ETH3D two-view", "maps"),
     Command("depth", "depth maps: Eigen abs_rel, sq_rel, rmse, rmse_log, a1..a3", "maps"),
+    Command("depth-sensor", "a ToF stream's range against its truth: error by range and incidence, completeness "
+                            "map, flying-pixel edges; Eigen depth metrics", "depth_sensor"),
     Command("flow", "optical flow: EPE all/noc/occ, KITTI Fl bg/fg/all, Sintel s0-10/s10-40/s40+", "flow"),
     Command("tracks", "point tracks over a sequence: TAP-Vid AJ, < delta_avg, OA against the truth tracks", "tracks"),
     Command("normals", "normal maps (photometric stereo): DiLiGenT mean/median angular error, < 10/20/30 deg; "

@@ -26,6 +26,8 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
   sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU;
 * ``kitti-velodyne``, ``nuscenes-lidar``, ``lidar-pcd``, ``lidar-ply``: a LiDAR stream's sweeps as
   KITTI ``.bin``, nuScenes ``.pcd.bin``, PCD and PLY point clouds (:mod:`.lidar`).
+* ``tof``: a ToF stream's raw frames as 16-bit PNG and float32 EXR (with its truth) and its
+  calibration JSON (intrinsics, frequencies, phase offsets, extrinsic, poses).
 """
 from __future__ import annotations
 
@@ -45,6 +47,7 @@ from scenegen.export import (
     opencv_yaml,
     sintel,
     tapvid,
+    tof,
     tracks_video,
     tum,
 )
@@ -59,14 +62,14 @@ FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.exp
            "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
            "euroc": euroc.export, "kitti-velodyne": lidar.export_kitti, "nuscenes-lidar": lidar.export_nuscenes,
            "lidar-pcd": lidar.export_pcd, "lidar-ply": lidar.export_ply,
-           "kitti-odometry": kitti_odometry.export}
+           "kitti-odometry": kitti_odometry.export, "tof": tof.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
                   "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
                   "euroc": "views", "kitti-velodyne": "sweeps", "nuscenes-lidar": "sweeps", "lidar-pcd": "sweeps",
-                  "lidar-ply": "sweeps", "kitti-odometry": "stereo frames"}
+                  "lidar-ply": "sweeps", "kitti-odometry": "stereo frames", "tof": "streams"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

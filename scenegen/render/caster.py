@@ -23,6 +23,7 @@ from scenegen.render.beams import cast_at_times
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
 from scenegen.render.frames import render_ideal, render_view
+from scenegen.render.tof import tof_pass
 from scenegen.render.truth import camera_rays, truth_pass
 
 
@@ -59,6 +60,16 @@ class Caster:
         timed = None if row_moves is None else (dev.timed(), row_moves)
         return truth_pass(dev.scene, camera, cam_from_world, dev.id_tables, row_poses=row_poses, as_stored=as_stored,
                           alpha_masked=dev.alpha_masked, timed=timed)
+
+    def tof(self, camera, cam_from_world: Rigid3, freqs_hz, *, spp: int, seed: int, max_bounces: int,
+            centre: bool = False, time_s: float | None = None) -> dict[str, np.ndarray]:
+        """Per-pixel path sums of a time-of-flight camera with its co-located emitter at a pose and
+        time: phasors per modulation frequency, direct light alone, first-hit range spread
+        (:func:`scenegen.render.tof.tof_pass`)."""
+        if mi.variant().startswith("scalar"):
+            raise NotImplementedError("a ToF camera needs a vectorised Mitsuba variant (llvm_ad_rgb / cuda_ad_rgb)")
+        return tof_pass(self._at(time_s).scene, camera, cam_from_world, freqs_hz, spp=spp, seed=seed,
+                        max_bounces=max_bounces, centre=centre)
 
     def albedo(self, camera, cam_from_world: Rigid3, *, time_s: float | None = None) -> np.ndarray:
         """(H, W, 3) float32 diffuse albedo per pixel centre (:func:`scenegen.render.albedo.albedo_pass`)."""

@@ -8,6 +8,7 @@ from scenegen.spec.sensors.imu import IMU
 from scenegen.spec.sensors.kind import SensorKind
 from scenegen.spec.sensors.lidar import LIDAR
 from scenegen.spec.sensors.wheel_odometry import WHEEL_ODOMETRY
+from scenegen.spec.sensors.tof import TOF
 
 #: Sensor kind name -> SensorKind (a rig member's default kind: RigMember.kind, the camera).
 SENSOR_KINDS: dict[str, SensorKind] = {
@@ -15,6 +16,7 @@ SENSOR_KINDS: dict[str, SensorKind] = {
     IMU.name: IMU,
     LIDAR.name: LIDAR,
     WHEEL_ODOMETRY.name: WHEEL_ODOMETRY,
+    TOF.name: TOF,
 }
 
 

@@ -27,6 +27,7 @@ from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
 from scenegen.spec.sensors.lidar import LidarSpec
 from scenegen.spec.sensors.wheel_odometry import WheelOdometrySpec
+from scenegen.spec.sensors.tof import TofSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -209,6 +210,13 @@ CASES += [(WheelOdometrySpec, key, "wheel_odometry:\n  w: {}\n",
            lambda s, key=key: getattr(s.sensors["wheel_odometry"]["w"], key), other)
           for key, other in [("rate_hz", 20.0), ("wheel_radius_m", 0.2), ("track_width_m", 0.3), ("slip_left", 0.1),
                              ("slip_right", 0.1), ("wheel_speed_noise_rad_s", 0.5)]]
+TOF = "cameras:\n  ir: {size: [32, 24], fx: 30}\ntof_cameras:\n  t: {camera: ir}\n"
+CASES += [(TofSpec, k, TOF, lambda s, k=k: getattr(s.sensors["tof"]["t"], k), v)
+          for k, v in (("frequency_mhz", 20.0), ("spp", 4), ("max_bounces", 1), ("pixel_centre_rays", True),
+                       ("integration_s", 0.002), ("signal_e_per_s_at_1m", 1e5), ("ambient_e_per_s", 10.0),
+                       ("contrast", 0.5), ("noise", False), ("read_noise_e", 1.0), ("gain_dn_per_e", 0.5),
+                       ("full_well_e", 1000.0), ("adc_bits", 12), ("min_amplitude_e", 5.0),
+                       ("flying_threshold_m", 0.1))]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
