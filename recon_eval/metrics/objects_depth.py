@@ -67,3 +67,15 @@ class DepthRenderer:
         K = np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
         vertices, faces = self._meshes[obj_id]
         return {"depth": render_depth(vertices, faces, R, t, K, self.width, self.height)}
+
+
+def model_points(depth, R, t, K) -> np.ndarray:
+    """(H, W, 3) model-frame points seen at each pixel of a :func:`render_depth` image of a model
+    posed by ``R``, ``t`` (NaN where the depth is 0): ``R^T (z K^-1 [u, v, 1] - t)``."""
+    d = np.asarray(depth, dtype=np.float64)
+    v, u = np.mgrid[0:d.shape[0], 0:d.shape[1]]
+    rays = np.stack([u, v, np.ones_like(u)], axis=-1).astype(np.float64) @ np.linalg.inv(K).T
+    cam = rays * d[..., None]
+    out = (cam - np.asarray(t, dtype=np.float64).reshape(3)) @ np.asarray(R, dtype=np.float64).reshape(3, 3)
+    out[d <= 0] = np.nan
+    return out

@@ -193,8 +193,9 @@ def derived_targets(gts: dict, visib_min: float = TARGET_VISIB_MIN) -> tuple:
     return tuple(out)
 
 
-def read_bop_dataset(path) -> BopDataset:
-    """A BOP dataset folder or one of its split folders (``test/``), or a single scene folder."""
+def read_bop_dataset(path, *, with_targets: bool = True) -> BopDataset:
+    """A BOP dataset folder or one of its split folders (``test/``), or a single scene folder.
+    ``with_targets=False``: no targets (a reference split such as ``train/``)."""
     p = Path(path)
     if not p.is_dir():
         raise InputError(f"{p}: not a folder (expected a BOP dataset, split or scene folder)")
@@ -219,6 +220,8 @@ def read_bop_dataset(path) -> BopDataset:
         views.update(v)
     models = _models(root, {g.obj_id for poses in gts.values() for g in poses})
     tfile = root / "test_targets_bop19.json"
+    if not with_targets:
+        return BopDataset(root, split, gts, views, models, (), "none")
     if tfile.is_file():
         doc = _json(tfile, "BOP test_targets_bop19.json")
         targets = []
