@@ -3,7 +3,8 @@ with object truth (``truth: {objects: true}``): ``images/<image id:06d>.png`` an
 ``annotations.json`` with ``images``, ``categories`` and ``annotations``.
 
 * An image per view, ids 1.. in the dataset's view order.
-* A category per model (id = the object truth's ``model_id``, name = the model); a model whose
+* A category per model of an instance's root (id = the object truth's ``model_id``, name = the
+  model; the parts of an articulated figure are not categories of their own); a model whose
   instances (or their parts) carry keypoints lists their names as ``keypoints`` and its
   ``skeleton`` as 1-based index pairs into them.
 * An annotation per instance seen in the view: an annotated object without an annotated parent,
@@ -83,7 +84,7 @@ def _keypoints(members, names) -> tuple[list[float], int]:
 
 
 def export(ds, dest, progress=None) -> dict:
-    images, annotations, models = [], [], {}
+    images, annotations, models, roots = [], [], {}, set()
     for k, view in enumerate(ds.views):
         try:
             objs = ds.objects(view)
@@ -100,6 +101,7 @@ def export(ds, dest, progress=None) -> dict:
         images.append({"id": image_id, "file_name": file_name, "width": W, "height": H})
         ids = ds.truth(view)[TruthKind.OBJECT_ID]
         for root, members in _roots(objs):
+            roots.add(root.model_id)
             mask = np.isin(ids, [m.object_id for m in members if m.present])
             if not root.present or not mask.any():
                 continue
@@ -113,8 +115,9 @@ def export(ds, dest, progress=None) -> dict:
             annotations.append(ann)
         if progress is not None:
             progress(k + 1, len(ds.views))
+    used = sorted({a["category_id"] for a in annotations} | roots)
     doc = {"info": {"description": f"scenegen dataset {ds.root.name}", "version": "1.0"}, "licenses": [],
-           "images": images, "categories": _categories(models[i] for i in sorted(models)),
+           "images": images, "categories": _categories(models[i] for i in used),
            "annotations": annotations}
     write(dest, "annotations.json", encode_json(doc))
     return {"files": len(images) + 1, "images": len(images), "annotations": len(annotations),

@@ -86,33 +86,52 @@ def model_infos(spec, built) -> tuple[ModelInfo, ...]:
     return tuple(out)
 
 
-def _keypoints(spec, built, obj, world_from_object, states, camera, view, time_s) -> tuple[KeypointTruth, ...]:
-    """The object's keypoints at ``world_from_object``, projected, with their states; ``states``:
-    every object's state at ``time_s`` (None: a static spec)."""
-    names, X = keypoint_positions(built, obj)
-    if not names:
-        return ()
+def root_of(spec, obj):
+    """The top of ``obj``'s annotated articulated tree (itself when its parent is not annotated)."""
+    root = obj
+    while parent_of(root) is not None and spec_object(spec, parent_of(root)).annotation is not None:
+        root = spec_object(spec, parent_of(root))
+    return root
+
+
+def view_keypoints(spec, built, view, poses: dict, camera) -> dict[str, tuple[KeypointTruth, ...]]:
+    """{object name: its keypoints projected, with their states} of the annotated objects present
+    in ``view``; ``poses`` {name: world_from_object} of those present. One cast through the scene
+    for all of them, and one per object alone over the keypoints of its tree: an object's own
+    articulated tree hides them "by itself"."""
+    time_s = getattr(view, "time_s", None)
     centre = view.cam_from_world.inverse().t
-    cam_from_object = view.cam_from_world @ world_from_object
-    P_cam = cam_from_object.apply(X)
-    uv, ok = camera.project(P_cam, return_valid=True)
-    ok &= np.isfinite(uv).all(axis=1)
-    P = world_from_object.apply(X)
+    rows = []  # (object, names, (K, 3) object frame)
+    for obj in annotated(spec):
+        names, X = keypoint_positions(built, obj)
+        if names and obj.name in poses:
+            rows.append((obj, names, X))
+    if not rows:
+        return {}
+    P = np.concatenate([poses[o.name].apply(X) for o, _, X in rows])
     v = P - centre
     dist = np.linalg.norm(v, axis=1)
     d = v / dist[:, None]
     t_scene = built.first_hit_distance(centre, d, time_s=time_s)
-    root = obj
-    while parent_of(root) is not None and spec_object(spec, parent_of(root)).annotation is not None:
-        root = spec_object(spec, parent_of(root))
+    tree = np.array([root_of(spec, o).name for o, names, _ in rows for _ in names])
     t_self = np.full(len(d), np.inf)
-    for part in tree_of(spec, root):  # its own articulated tree hides it "by itself"
-        pose = part.transform.world_from_object if states is None else states[part.name].world_from_object
-        if states is None or states[part.name].present:
-            t_self = np.minimum(t_self, built.alone_distances(part.object_id, pose, centre, d))
-    st = keypoint_states(uv, ok, camera.width, camera.height, dist, t_scene, t_self)
-    return tuple(KeypointTruth(n, X[k], np.where(ok[k], uv[k], np.nan), float(P_cam[k, 2]) if ok[k] else float("nan"),
-                               st[k]) for k, n in enumerate(names))
+    for root in dict.fromkeys(tree):
+        sel = tree == root
+        for part in tree_of(spec, spec_object(spec, root)):
+            if part.name in poses:
+                t_self[sel] = np.minimum(t_self[sel], built.alone_distances(part.object_id, poses[part.name], centre, d[sel]))
+    out, k0 = {}, 0
+    for obj, names, X in rows:
+        k1 = k0 + len(names)
+        P_cam = (view.cam_from_world @ poses[obj.name]).apply(X)
+        uv, ok = camera.project(P_cam, return_valid=True)
+        ok &= np.isfinite(uv).all(axis=1)
+        st = keypoint_states(uv, ok, camera.width, camera.height, dist[k0:k1], t_scene[k0:k1], t_self[k0:k1])
+        out[obj.name] = tuple(KeypointTruth(n, X[k], np.where(ok[k], uv[k], np.nan),
+                                            float(P_cam[k, 2]) if ok[k] else float("nan"), st[k])
+                              for k, n in enumerate(names))
+        k0 = k1
+    return out
 
 
 def spec_object(spec, name: str):
@@ -148,9 +167,12 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
     H, W = camera.height, camera.width
     mids = model_ids(spec)
     objects, masks = [], []
+    poses = {o.name: o.transform.world_from_object if states is None else states[o.name].world_from_object
+             for o in annotated(spec) if states is None or states[o.name].present}
+    keypoints = view_keypoints(spec, built, view, poses, camera)
     for obj in annotated(spec):
         pose = obj.transform.world_from_object if states is None else states[obj.name].world_from_object
-        present = True if states is None else bool(states[obj.name].present)
+        present = obj.name in poses
         visible = ids == obj.object_id
         alone = np.zeros(len(dirs), bool)
         if present:
@@ -160,11 +182,10 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
         # other way by the float32 rounding of the alone cast still counts (counted in the tests)
         in_image_block(alone, W, H)[visible] = True
         n_all, n_vis, fract = silhouette_stats(alone, visible)
-        kps = _keypoints(spec, built, obj, pose, states, camera, view, time_s) if present else ()
         objects.append(ObjectTruth(
             obj.name, obj.object_id, obj.instance_id, obj.annotation.model, mids[obj.annotation.model],
             parent_of(obj), present, view.cam_from_world @ pose, pose, obj.transform.world_from_object,
-            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), kps))
+            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), keypoints.get(obj.name, ())))
         masks.append(in_image_block(alone, W, H))
     return ViewObjects(view.name, (W, H), view.cam_from_world, model_infos(spec, built), tuple(objects),
                        np.asarray(masks, bool).reshape(len(objects), H, W))

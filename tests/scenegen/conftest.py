@@ -3,6 +3,7 @@ the cross-view, stereo and export tests (rendered once per session; ~5 s on 2 co
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
 
@@ -124,5 +125,18 @@ def objects_dataset(tmp_path_factory):
     d = tmp_path_factory.mktemp("objects")
     spec = d / "objects.yaml"
     spec.write_text(OBJECTS_SPEC)
+    render_spec(spec, d / "out", progress=False)
+    return d / "out"
+
+
+@pytest.fixture(scope="session")
+def figure_dataset(tmp_path_factory):
+    """scenes/articulated_figure.yaml at 64x48 px, 1 spp (three frames; eleven parts on joints,
+    13 keypoints visible, self-occluded and occluded by a post): the path of the dataset."""
+    text = (Path(__file__).parents[2] / "scenes" / "articulated_figure.yaml").read_text()
+    text = text.replace("size: [160, 120], fx: 190", "size: [64, 48], fx: 76").replace("spp: 16", "spp: 1")
+    d = tmp_path_factory.mktemp("figure")
+    spec = d / "figure.yaml"
+    spec.write_text(text)
     render_spec(spec, d / "out", progress=False)
     return d / "out"

@@ -1,7 +1,8 @@
 """Object truth (``truth: {objects: true}``) against independent computations: trimesh's ray
 caster over the stored meshes placed by the stored ``cam_from_object`` (ids, depth, the
 silhouette alone, keypoint visibility), cv2.projectPoints (keypoints), scipy's pairwise
-distances (diameter). The dataset is the session fixture ``objects_dataset`` (64x48, 1 spp)."""
+distances (diameter). The datasets are the session fixtures ``objects_dataset`` and
+``figure_dataset`` (64x48, 1 spp)."""
 import cv2
 import numpy as np
 import pytest
@@ -24,9 +25,10 @@ EDGE_PIXELS = 2
 DEPTH_REL_TOL = 1e-5
 
 
-@pytest.fixture(scope="module")
-def ds(objects_dataset):
-    return Dataset(objects_dataset)
+@pytest.fixture(scope="module", params=["objects_dataset", "figure_dataset"])
+def ds(request):
+    """The table-top (static) and the articulated figure (its parts on joints, three frames)."""
+    return Dataset(request.getfixturevalue(request.param))
 
 
 def _model(ds, o) -> trimesh.Trimesh:
@@ -112,7 +114,9 @@ def test_ids_and_depth_equal_a_trimesh_cast_of_the_models_at_cam_from_object(ds)
             compared[o.name] = compared.get(o.name, 0) + int(both.sum())
             z_ref = dz[both]
             np.testing.assert_allclose(truth["depth_z"].ravel()[both], z_ref, rtol=DEPTH_REL_TOL)
-    assert min(compared.values()) > 20, compared  # every object seen: the test has something to compare
+    # the test has something to compare: every object seen but at most one (the figure's right shin,
+    # behind the post at 64x48)
+    assert sum(n > 10 for n in compared.values()) >= len(compared) - 1, compared
 
 
 def test_full_masks_and_visible_fraction_equal_an_independent_cast_alone(ds):
@@ -167,7 +171,8 @@ def test_keypoints_equal_cv2_project_points_and_their_states_an_independent_cast
     assert {"visible", "self_occluded"} <= set(states)  # the scene shows both
 
 
-def test_vertex_keypoints_and_models(ds):
+def test_vertex_keypoints_and_models(objects_dataset):
+    ds = Dataset(objects_dataset)
     objs = ds.objects(ds.views[0])
     can = objs.by_name("can")
     side = [k for k in can.keypoints if k.name == "side"][0]
