@@ -21,13 +21,19 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
 * ``sintel``: MPI-Sintel layout (final/, flow/, occlusions/, invalid/, depth/, camdata_left/) per
   camera stream of a sequence of pinhole cameras;
 * ``euroc``: EuRoC MAV ``mav0/`` (camN images and data.csv, imu0, state_groundtruth_estimate0,
-  sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU.
+  sensor.yaml files) plus Kalibr's camchain.yaml and imu.yaml, from a rig of cameras and an IMU;
+* ``bop``: BOP's scenewise layout (scene_gt, scene_gt_info, scene_camera, rgb/, depth/, mask/,
+  mask_visib/, models/ with models_info.json, in mm) from the object truth;
+* ``coco``: COCO instances and keypoints (annotations.json: RLE masks, boxes, keypoints with
+  visibility, categories with skeletons) + images/, from the object truth.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from scenegen.export import (
+    bop,
+    coco,
     colmap,
     euroc,
     gaussian_splatting,
@@ -51,13 +57,14 @@ FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.exp
            "kitti-stereo": kitti_stereo.export, "middlebury": middlebury.export, "opencv": opencv_yaml.export,
            "tum": tum.export, "tapvid": tapvid.export, "tracks-video": tracks_video.export,
            "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
-           "euroc": euroc.export}
+           "euroc": euroc.export, "bop": bop.export,
+           "coco": coco.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
                   "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
-                  "euroc": "views"}
+                  "euroc": "views", "bop": "views", "coco": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

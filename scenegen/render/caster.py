@@ -19,6 +19,7 @@ import numpy as np
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast
 from scenegen.render.albedo import albedo_pass
+from scenegen.render.alone import alone_distances
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
 from scenegen.render.frames import render_ideal, render_view
@@ -103,6 +104,17 @@ class Caster:
         dev = self._at(time_s)
         timed = None if moves is None else (dev.timed(), moves)
         return raycast.surface_points(dev.scene, camera, cam_from_world, uv, dev.alpha_masked, rows, timed)
+
+    def alone_distances(self, object_id: int, world_from_object: Rigid3, origin_world, directions_world) -> np.ndarray:
+        """(N,) float64 distances along unit rays to one object alone at ``world_from_object``
+        (+inf: missed; :func:`scenegen.render.alone.alone_distances`)."""
+        return alone_distances(self.device, object_id, world_from_object, origin_world, directions_world)
+
+    def first_hit_distance(self, origin_world, directions_world, *, time_s: float | None = None) -> np.ndarray:
+        """(N,) float64 distances along unit rays to the first surface of the scene at ``time_s``
+        (+inf: missed; :func:`scenegen.render.raycast.first_hit_distance`)."""
+        dev = self._at(time_s)
+        return raycast.first_hit_distance(dev.scene, origin_world, directions_world, dev.alpha_masked)[0]
 
     def _at(self, time_s: float | None) -> DeviceScene:
         self.device.place_at(time_s)
