@@ -11,7 +11,7 @@ from recon_eval.cli.scored import scored
 from recon_eval.errors import InputError
 from recon_eval.metrics.objects_bop_eval import VSD_DELTA_MM, bop19_evaluate
 from recon_eval.metrics.objects_coco import keypoint_ap, oks
-from recon_eval.metrics.objects_parts import PCK_ALPHAS, pck
+from recon_eval.metrics.objects_parts import PCK_ALPHAS, PckResult, pck
 from recon_eval.readers.bop import read_bop_dataset, read_bop_results
 from recon_eval.readers.coco import read_coco_keypoint_results, read_coco_keypoint_truth
 from recon_eval.report import plots
@@ -31,7 +31,8 @@ def arguments(p) -> None:
     p.add_argument("--coco", metavar="JSON", help="keypoint result in COCO's results format")
     p.add_argument("--coco-gt", metavar="JSON", help="the COCO keypoint annotation file (default: found under GT)")
     p.add_argument("--kpt-sigmas", type=float, nargs="+", metavar="S",
-                   help="per-keypoint OKS sigmas (default: the annotation file's category sigmas, or COCO's 17)")
+                   help="OKS sigmas for categories that declare none: one value for every keypoint or one per "
+                        "keypoint (default: COCO's 17 person sigmas for a 17-keypoint category, else required)")
     p.add_argument("--vsd-delta", type=float, default=VSD_DELTA_MM,
                    help=f"VSD visibility tolerance in mm (eval_bop19_pose.py: {VSD_DELTA_MM:g}; ITODD 5)")
 
@@ -69,7 +70,7 @@ def pck_pairs(truths, dets, sigmas):
         cands = [d for d in by_key.get((t.image_id, t.category_id), []) if id(d) not in used]
         best = None
         if cands:
-            s = oks(cands, [t], sigmas)[:, 0]
+            s = oks(cands, [t], sigmas[t.category_id])[:, 0]
             best = cands[int(np.argmax(s))]
             used.add(id(best))
         pred.append(best.keypoints[:, :2] if best is not None else np.full((len(t.keypoints), 2), np.nan))
@@ -77,6 +78,23 @@ def pck_pairs(truths, dets, sigmas):
         lab.append(t.keypoints[:, 2] > 0)
         size.append(max(t.bbox[2], t.bbox[3]))
     return np.array(pred), np.array(gt), np.array(lab, dtype=bool), np.array(size)
+
+
+def pck_pooled(groups) -> PckResult:
+    """PCK over groups of (pred, gt, labelled, size) with different keypoint counts: one
+    keypoint list, each keypoint with its instance's reference size."""
+    pred, gt, lab, size = [], [], [], []
+    for p, g, lb, sz in groups:
+        if len(p) == 0:
+            continue
+        pred.append(p.reshape(-1, 2))
+        gt.append(g.reshape(-1, 2))
+        lab.append(lb.reshape(-1))
+        size.append(np.repeat(sz, lb.shape[1]))
+    if not pred:
+        return pck(np.zeros((0, 1, 2)), np.zeros((0, 1, 2)), np.zeros((0, 1), bool), np.zeros(0), alphas=PCK_ALPHAS)
+    return pck(np.concatenate(pred)[:, None], np.concatenate(gt)[:, None], np.concatenate(lab)[:, None],
+               np.concatenate(size), alphas=PCK_ALPHAS)
 
 
 def score(a):
@@ -98,9 +116,13 @@ def score(a):
     if a.coco:
         cf = _coco_file(a)
         truth = read_coco_keypoint_truth(cf, a.kpt_sigmas)
-        dets = read_coco_keypoint_results(a.coco, truth.image_ids, len(truth.sigmas))
+        dets = read_coco_keypoint_results(a.coco, truth.image_ids, {c: len(s) for c, s in truth.sigmas.items()})
         res["coco_keypoints"] = keypoint_ap(truth.truths, dets, sigmas=truth.sigmas, image_ids=truth.image_ids)
-        res["pck"] = pck(*pck_pairs(truth.truths, dets, truth.sigmas), alphas=PCK_ALPHAS)
+        pairs = {}  # PCK per category (keypoint counts differ), pooled
+        for c in truth.sigmas:
+            pairs[c] = pck_pairs([t for t in truth.truths if t.category_id == c],
+                                 [d for d in dets if d.category_id == c], truth.sigmas)
+        res["pck"] = pck_pooled(pairs.values())
         inputs.update(coco_gt=str(cf), kpt_sigmas=truth.sigmas_source,
                       pck="highest-OKS detection per truth, threshold alpha * max(box w, h), <=")
 

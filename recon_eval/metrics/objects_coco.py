@@ -158,7 +158,9 @@ class CocoKeypointResult:
 
 def keypoint_ap(truths, detections, *, sigmas=COCO_PERSON_SIGMAS, image_ids=None) -> CocoKeypointResult:
     """COCO keypoint AP/AR of ``detections`` against ``truths`` over ``image_ids`` (default: the
-    truths' images; COCO's are the annotation file's ``images``)."""
+    truths' images; COCO's are the annotation file's ``images``). ``sigmas``: (K,) for every
+    category, or a dict category_id -> (K_c,) where categories have their own keypoints
+    (pycocotools holds one vector: the same numbers when all categories share it)."""
     imgs = sorted(set(image_ids) if image_ids is not None else {g.image_id for g in truths})
     cats = sorted({g.category_id for g in truths})
     gts: dict = {}
@@ -168,7 +170,8 @@ def keypoint_ap(truths, detections, *, sigmas=COCO_PERSON_SIGMAS, image_ids=None
     for d in detections:
         dts.setdefault((d.image_id, d.category_id), []).append(d)
     ranked = {k: _ranked(v, MAX_DETS) for k, v in dts.items()}
-    ious = {(i, c): (oks(ranked.get((i, c), []), gts.get((i, c), []), sigmas)
+    per_cat = sigmas if isinstance(sigmas, dict) else {c: sigmas for c in cats}
+    ious = {(i, c): (oks(ranked.get((i, c), []), gts.get((i, c), []), per_cat[c])
                      if ranked.get((i, c)) and gts.get((i, c)) else np.zeros((0, 0))) for i in imgs for c in cats}
     T, R = len(OKS_THRESHOLDS), len(RECALL_POINTS)
     precision = -np.ones((T, R, len(cats), len(AREA_RANGES)))

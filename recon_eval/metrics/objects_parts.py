@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from recon_eval.metrics.objects_bop import SymmetryTransforms, add, rot_trans_error
+from scenegen.geometry.rotation import rotation_error_rad
 
 #: PCK thresholds reported by default (fractions of the reference size).
 PCK_ALPHAS = (0.05, 0.1, 0.2)
@@ -80,3 +81,22 @@ def articulated_pose_errors(est: dict, gt: dict, points: dict, syms: dict | None
         tuple(parts), joints, max((p.rot_err_deg for p in parts), default=float("nan")),
         max((p.trans_err for p in parts), default=float("nan")),
         float(np.mean(list(joints.values()))) if joints else float("nan"))
+
+
+def joint_rotation_errors(est: dict, gt: dict, parents: dict) -> dict:
+    """Per child part, the angle (deg) of ``(R_parent^T R_child)_est^T (R_parent^T R_child)_gt``:
+    how far the recovered relative rotation of each joint is from the truth's. For a revolute
+    joint whose estimate turns about the joint's axis it is ``|angle_est - angle_gt|``; it needs
+    no axis, so it applies to any joint. ``est``, ``gt``: part -> (R (3, 3), t (3,));
+    ``parents``: child -> parent. A joint with a part missing from ``est`` is inf."""
+    out = {}
+    for child, parent in parents.items():
+        if parent is None or child not in gt or parent not in gt:
+            continue
+        if child not in est or parent not in est:
+            out[child] = float("inf")
+            continue
+        rel_e = np.asarray(est[parent][0]).T @ np.asarray(est[child][0])
+        rel_g = np.asarray(gt[parent][0]).T @ np.asarray(gt[child][0])
+        out[child] = float(np.degrees(rotation_error_rad(rel_e, rel_g)))
+    return out

@@ -64,15 +64,31 @@ def _keypoints(d, where: str, k: int | None) -> np.ndarray:
 class CocoKeypointTruthFile:
     truths: tuple  # KeypointTruth
     image_ids: tuple
-    sigmas: np.ndarray  # (K,) per keypoint
-    sigmas_source: str
+    sigmas: dict  # category_id -> (K_c,) per-keypoint OKS sigmas
+    sigmas_source: dict  # category_id -> where its sigmas came from
+
+
+def _category_sigmas(c: dict, k: int, given, where: str) -> tuple[np.ndarray, str]:
+    """A category's sigmas: its own ``sigmas`` list (not in COCO's format; a tool may write it),
+    else ``given`` (K numbers, or one for every keypoint), else COCO's 17 person sigmas when it
+    has 17 keypoints."""
+    if "sigmas" in c:
+        s, src = _numbers(c, "sigmas", where, k), "the category's sigmas"
+    elif given is not None and len(given) in (1, k):
+        s, src = np.broadcast_to(np.asarray(given, dtype=np.float64), (k,)).copy(), "--kpt-sigmas"
+    elif k == 17:
+        s, src = COCO_PERSON_SIGMAS, "COCO's 17 person keypoint sigmas"
+    else:
+        raise InputError(f"{where}: {k} keypoints and no OKS sigmas for them: give --kpt-sigmas (one value for "
+                         "every keypoint, or one per keypoint; COCO's defaults are for its 17 person keypoints)")
+    if not np.all(s > 0):
+        raise InputError(f"{where}: OKS sigmas must be positive ({src})")
+    return s, src
 
 
 def read_coco_keypoint_truth(path, sigmas=None) -> CocoKeypointTruthFile:
-    """The annotations with keypoints of a COCO annotation file. Per-keypoint OKS sigmas:
-    ``sigmas`` if given, else a category's ``sigmas`` list (not in COCO's format: scenegen's
-    export writes it for its own skeletons), else COCO's 17 person sigmas when there are 17
-    keypoints."""
+    """The annotations with keypoints of a COCO annotation file; each category's keypoint count
+    is its ``keypoints`` names' count (else its first annotation's)."""
     p, doc = _doc(path, "a COCO annotation file")
     images = _get(doc, "images", str(p))
     anns = _get(doc, "annotations", str(p))
@@ -80,44 +96,43 @@ def read_coco_keypoint_truth(path, sigmas=None) -> CocoKeypointTruthFile:
     if not isinstance(images, list) or not isinstance(anns, list) or not isinstance(cats, list):
         raise InputError(f"{p}: images, annotations and categories must be lists")
     image_ids = tuple(_int(im, "id", f"{p}: images[{i}]") for i, im in enumerate(images))
-    truths, n_kp = [], None
+    n_kp = {}
+    for j, c in enumerate(cats):
+        cid = _int(c, "id", f"{p}: categories[{j}]")
+        if isinstance(c.get("keypoints"), list) and c["keypoints"]:
+            n_kp[cid] = len(c["keypoints"])
+    truths = []
     for i, a in enumerate(anns):
         where = f"{p}: annotations[{i}]"
         if not isinstance(a, dict) or "keypoints" not in a:
             continue  # an instance without keypoints: not a keypoint truth
-        kp = _keypoints(a, where, n_kp)
-        n_kp = len(kp)
+        cid = _int(a, "category_id", where)
+        kp = _keypoints(a, where, n_kp.get(cid))
+        n_kp.setdefault(cid, len(kp))
         if not np.all(np.isin(kp[:, 2], (0, 1, 2))):
             raise InputError(f"{where}.keypoints: visibility flags must be 0, 1 or 2")
         if _int(a, "image_id", where) not in image_ids:
             raise InputError(f"{where}.image_id: {a['image_id']} is not in images")
         bbox = _numbers(a, "bbox", where, 4)
         nk = _int(a, "num_keypoints", where) if "num_keypoints" in a else None
-        truths.append(KeypointTruth(_int(a, "id", where), a["image_id"], _int(a, "category_id", where), kp,
-                                    tuple(float(x) for x in bbox), _scalar(a, "area", where),
-                                    bool(a.get("iscrowd", 0)), nk))
+        truths.append(KeypointTruth(_int(a, "id", where), a["image_id"], cid, kp, tuple(float(x) for x in bbox),
+                                    _scalar(a, "area", where), bool(a.get("iscrowd", 0)), nk))
     if not truths:
         raise InputError(f"{p}: no annotation has keypoints (expected a COCO keypoint annotation file)")
-    if sigmas is not None:
-        s, src = np.asarray(sigmas, dtype=np.float64), "given"
-    else:
-        with_sigmas = [c for c in cats if isinstance(c, dict) and "sigmas" in c]
-        if with_sigmas:
-            s, src = _numbers(with_sigmas[0], "sigmas", f"{p}: categories[{cats.index(with_sigmas[0])}]", n_kp), \
-                "the category's sigmas"
-        elif n_kp == 17:
-            s, src = COCO_PERSON_SIGMAS, "COCO's 17 person keypoint sigmas"
-        else:
-            raise InputError(f"{p}: {n_kp} keypoints per instance and no per-keypoint OKS sigmas: give --kpt-sigmas "
-                             "(COCO's defaults are for its 17 person keypoints)")
-    if s.size != n_kp or not np.all(s > 0):
-        raise InputError(f"{p}: expected {n_kp} positive OKS sigmas ({src}), got {s.size}")
-    return CocoKeypointTruthFile(tuple(truths), image_ids, s, src)
+    used = sorted({t.category_id for t in truths})
+    by_id = {c.get("id"): (j, c) for j, c in enumerate(cats) if isinstance(c, dict)}
+    sig, src = {}, {}
+    for cid in used:
+        j, c = by_id.get(cid, (None, {}))
+        where = f"{p}: categories[{j}]" if j is not None else f"{p}: category {cid}"
+        sig[cid], src[cid] = _category_sigmas(c, n_kp[cid], sigmas, where)
+    return CocoKeypointTruthFile(tuple(truths), image_ids, sig, src)
 
 
-def read_coco_keypoint_results(path, image_ids, n_keypoints: int) -> tuple:
+def read_coco_keypoint_results(path, image_ids, n_keypoints: dict) -> tuple:
     """A COCO keypoint result file: KeypointDetection per entry. As ``COCO.loadRes``, every
-    ``image_id`` must be an image of the annotation file."""
+    ``image_id`` must be an image of the annotation file; ``n_keypoints``: category_id -> K
+    (a category not in it is refused)."""
     p, doc = _doc(path, "a COCO keypoint result file")
     if not isinstance(doc, list):
         raise InputError(f"{p}: expected a JSON list of results")
@@ -127,6 +142,8 @@ def read_coco_keypoint_results(path, image_ids, n_keypoints: int) -> tuple:
         image_id = _int(r, "image_id", where)
         if image_id not in known:
             raise InputError(f"{where}.image_id: {image_id} is not an image of the annotation file")
-        out.append(KeypointDetection(image_id, _int(r, "category_id", where), _keypoints(r, where, n_keypoints),
-                                     _scalar(r, "score", where)))
+        cid = _int(r, "category_id", where)
+        if cid not in n_keypoints:
+            raise InputError(f"{where}.category_id: {cid} is not a keypoint category of the annotation file")
+        out.append(KeypointDetection(image_id, cid, _keypoints(r, where, n_keypoints[cid]), _scalar(r, "score", where)))
     return tuple(out)

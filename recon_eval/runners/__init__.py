@@ -149,6 +149,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("sift-pnp-ransac", "objects_features", "run",
        "invariant features: SIFT matches from the reference renders (train split) of each model to the image, "
        "cv2.solvePnPRansac (EPnP + refinement); BOP19 CSV"),
+    _m("parts-align-joints", "objects_parts", "run",
+       "parts: each part of an articulated object posed alone by the alignment method, joints recovered as the "
+       "parts' relative rotations; BOP19 CSV, per-part and joint errors"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

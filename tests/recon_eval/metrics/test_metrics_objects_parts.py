@@ -6,7 +6,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from recon_eval.metrics.objects_bop import symmetry_transforms
-from recon_eval.metrics.objects_parts import articulated_pose_errors, pck
+from recon_eval.metrics.objects_parts import articulated_pose_errors, joint_rotation_errors, pck
 
 
 def test_pck_counts_labelled_keypoints_within_alpha_size():
@@ -35,3 +35,13 @@ def test_part_errors_and_joint_angles():
     assert cap.rot_err_deg == pytest.approx(0.0, abs=1e-9)  # the declared 180 deg symmetry
     assert lost.rot_err_deg == np.inf and r.max_rot_err_deg == np.inf
     assert r.joint_err_deg == {"elbow": pytest.approx(2.0), "wrist": np.inf}
+
+
+def test_joint_rotation_error_is_the_joint_angle_difference():
+    axis_angle = lambda deg: Rotation.from_rotvec(np.radians(deg) * np.array([0.0, 1.0, 0.0])).as_matrix()  # noqa: E731
+    base = Rotation.from_rotvec([0.2, -0.4, 0.9]).as_matrix()
+    t = np.zeros(3)
+    gt = {"torso": (base, t), "arm": (base @ axis_angle(30), t), "hand": (base @ axis_angle(30) @ axis_angle(10), t)}
+    est = {"torso": (base, t), "arm": (base @ axis_angle(37), t)}
+    e = joint_rotation_errors(est, gt, {"arm": "torso", "hand": "arm", "torso": None})
+    assert e["arm"] == pytest.approx(7.0) and e["hand"] == np.inf and "torso" not in e
