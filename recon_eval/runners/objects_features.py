@@ -47,9 +47,10 @@ def reference_features(ref, sift) -> dict:
     out: dict = {}
     for (scene_id, im_id), gts in sorted(ref.gts.items()):
         view = ref.views[(scene_id, im_id)]
-        if len(gts) != 1 or view.depth is None:
+        seen = [g for g in gts if g.visib_fract > 0]
+        if len(seen) != 1 or view.depth is None:
             continue  # a reference render shows one model, with depth
-        g = gts[0]
+        g = seen[0]
         kps, desc = sift.detectAndCompute(_grey(ref.split, scene_id, im_id), None)
         if desc is None:
             continue

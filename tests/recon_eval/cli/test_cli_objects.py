@@ -154,3 +154,17 @@ def test_bad_coco_fields_are_named(bop, tmp_path, capsys):
     ann.write_text(json.dumps(doc))
     code, _, err = run(["objects", root, "--coco", res, "--coco-gt", ann], capsys)
     assert code == 2 and "ann.json: annotations[0].bbox: expected 4 finite numbers" in err
+
+
+def test_undeclared_sigmas_need_kpt_sigmas(bop, tmp_path, capsys):
+    root, _ = bop
+    ann, res = _coco(tmp_path)
+    doc = json.loads(ann.read_text())
+    del doc["categories"][0]["sigmas"]
+    ann.write_text(json.dumps(doc))
+    code, _, err = run(["objects", root, "--coco", res, "--coco-gt", ann], capsys)
+    assert code == 2 and "ann.json: categories[0]: 3 keypoints and no OKS sigmas for them: give --kpt-sigmas" in err
+    code, _, err = run(["objects", root, "--coco", res, "--coco-gt", ann, "--kpt-sigmas", "0.05", "--json",
+                        tmp_path / "s.json", "--quiet"], capsys)
+    doc = json.loads((tmp_path / "s.json").read_text())
+    assert code == 0 and doc["metrics"]["coco_kp_ap"] == 1.0 and doc["inputs"]["kpt_sigmas"] == {"1": "--kpt-sigmas"}
