@@ -147,7 +147,8 @@ def headline(a, res) -> dict:
                   "add_recall": r.add_recall, "adds_recall": r.adds_recall})
     if "coco_keypoints" in res:
         m.update({"coco_kp_ap": res["coco_keypoints"].ap, "coco_kp_ap50": res["coco_keypoints"].ap50})
-        m.update({f"pck@{al:g}": v for al, v in zip(res["pck"].alphas, res["pck"].pck)})
+        # pck_10 = PCK at alpha 0.10 (no dot: metric paths split on dots)
+        m.update({f"pck_{round(al * 100):02d}": v for al, v in zip(res["pck"].alphas, res["pck"].pck)})
     return m
 
 

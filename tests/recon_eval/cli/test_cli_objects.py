@@ -102,7 +102,7 @@ def test_perfect_and_flipped_results(bop, tmp_path, capsys):
     assert code == 0, err
     doc = json.loads((tmp_path / "o.json").read_text())
     m = doc["metrics"]
-    assert m["bop19_ar"] == 1.0 and m["add_recall"] == 1.0 and m["coco_kp_ap"] == 1.0 and m["pck@0.05"] == 1.0
+    assert m["bop19_ar"] == 1.0 and m["add_recall"] == 1.0 and m["coco_kp_ap"] == 1.0 and m["pck_05"] == 1.0
     assert doc["results"]["bop19"]["n_targets"] == 4 and doc["results"]["bop19"]["mean_time_per_image_s"] == 0.25
     assert (tmp_path / "o.html").stat().st_size > 1000
     code, _, err = run(["objects", root, "--bop", _csv(tmp_path / "f.csv", gt, flip=True), "--json",
@@ -117,7 +117,7 @@ def test_perturbed_keypoints_lower_ap(bop, tmp_path, capsys):
     code, _, err = run(["objects", root, "--coco", res, "--coco-gt", ann, "--json", tmp_path / "k.json", "--quiet"],
                        capsys)
     m = json.loads((tmp_path / "k.json").read_text())["metrics"]
-    assert code == 0 and 0 < m["coco_kp_ap"] < 1 and m["pck@0.2"] == 1.0 and m["pck@0.05"] < 1
+    assert code == 0 and 0 < m["coco_kp_ap"] < 1 and m["pck_20"] == 1.0 and m["pck_05"] < 1
 
 
 BAD_CSV = [
