@@ -168,3 +168,19 @@ def test_undeclared_sigmas_need_kpt_sigmas(bop, tmp_path, capsys):
                         tmp_path / "s.json", "--quiet"], capsys)
     doc = json.loads((tmp_path / "s.json").read_text())
     assert code == 0 and doc["metrics"]["coco_kp_ap"] == 1.0 and doc["inputs"]["kpt_sigmas"] == {"1": "--kpt-sigmas"}
+
+
+def test_gates_read_the_headline(bop, tmp_path, capsys):
+    root, gt = bop
+    code, _, err = run(["objects", root, "--bop", _csv(tmp_path / "f.csv", gt, flip=True), "--method", "flipper",
+                        "--scene", "synthetic", "--json", tmp_path / "f.json", "--quiet"], capsys)
+    assert code == 0, err
+    gates = tmp_path / "g.yaml"
+    gates.write_text("version: 1\ngates:\n"
+                     "  - {scene: synthetic, method: flipper, metric: bop19_ar_mssd, op: '>=', threshold: 1.0}\n"
+                     "  - {scene: synthetic, method: flipper, metric: adds_recall, op: '>=', threshold: 1.0}\n")
+    assert run(["gate", gates, tmp_path / "f.json"], capsys)[0] == 0
+    gates.write_text("version: 1\ngates:\n"
+                     "  - {scene: synthetic, method: flipper, metric: add_recall, op: '>=', threshold: 0.9,\n"
+                     "     reason: a symmetric flip is wrong for ADD}\n")
+    assert run(["gate", gates, tmp_path / "f.json"], capsys)[0] == 1
