@@ -4,7 +4,9 @@ perfect result scores 1, a flip of the symmetric box is correct, the JSON carrie
 for gates, and bad input is one line naming the file, line or field, exit 2."""
 from __future__ import annotations
 
+import importlib.util
 import json
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -13,7 +15,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from recon_eval.cli import main
-from recon_eval.metrics.objects_depth import render_depth
+from recon_eval.metrics.objects_depth import DepthRenderer, render_depth
 
 W, H = 48, 36
 K = [60.0, 0.0, 23.5, 0.0, 60.0, 17.5, 0.0, 0.0, 1.0]
@@ -184,3 +186,52 @@ def test_gates_read_the_headline(bop, tmp_path, capsys):
                      "  - {scene: synthetic, method: flipper, metric: add_recall, op: '>=', threshold: 0.9,\n"
                      "     reason: a symmetric flip is wrong for ADD}\n")
     assert run(["gate", gates, tmp_path / "f.json"], capsys)[0] == 1
+
+
+def _reference():
+    """The copied bop_toolkit (tests/recon_eval/agreement/bop_toolkit_reference.py)."""
+    path = Path(__file__).parents[1] / "agreement" / "bop_toolkit_reference.py"
+    spec = importlib.util.spec_from_file_location("bop_toolkit_reference_cli", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_same_ar_as_the_copied_bop_toolkit_on_the_same_files(bop, tmp_path, capsys):
+    """The CLI (our readers + metrics) against the reference loop fed from the files as
+    bop_toolkit's inout reads them (json, the depth PNG times depth_scale, the PLY vertices)."""
+    root, gt = bop
+    rng = np.random.default_rng(5)
+    lines = ["scene_id,im_id,obj_id,score,R,t,time"]
+    for im, anns in gt.items():
+        for a in anns:
+            R = Rotation.from_rotvec(rng.normal(0, 0.06, 3)).as_matrix() @ np.reshape(a["cam_R_m2c"], (3, 3))
+            t = np.asarray(a["cam_t_m2c"]) + rng.normal(0, 4, 3)
+            lines.append(f"1,{im},{a['obj_id']},{rng.uniform():.6f},{' '.join(f'{x:.9f}' for x in R.ravel())},"
+                         f"{' '.join(f'{x:.6f}' for x in t)},0.25")
+    (tmp_path / "p.csv").write_text("\n".join(lines) + "\n")
+    code, _, err = run(["objects", root, "--bop", tmp_path / "p.csv", "--json", tmp_path / "p.json", "--quiet"], capsys)
+    assert code == 0, err
+    ours = json.loads((tmp_path / "p.json").read_text())["metrics"]
+    ref = _reference()
+    sdir = root / "test" / "000001"
+    scene_gt = {int(k): [dict(g, cam_R_m2c=np.reshape(g["cam_R_m2c"], (3, 3)), cam_t_m2c=np.reshape(g["cam_t_m2c"],
+                                                                                                    (3, 1)))
+                         for g in v] for k, v in json.loads((sdir / "scene_gt.json").read_text()).items()}
+    info = {int(k): v for k, v in json.loads((sdir / "scene_gt_info.json").read_text()).items()}
+    cam = {int(k): dict(v, cam_K=np.reshape(v["cam_K"], (3, 3)))
+           for k, v in json.loads((sdir / "scene_camera.json").read_text()).items()}
+    depth = {im: cv2.imread(str(sdir / "depth" / f"{im:06d}.png"), cv2.IMREAD_UNCHANGED).astype(np.float64)
+             for im in scene_gt}
+    models_info = {int(k): v for k, v in json.loads((root / "models" / "models_info.json").read_text()).items()}
+    meshes = {o: trimesh.load(root / "models" / f"obj_{o:06d}.ply", process=False) for o in models_info}
+    targets = [{"scene_id": 1, "im_id": im, "obj_id": o, "inst_count": 1} for im in scene_gt for o in (1, 2)]
+    ests = [{"scene_id": int(f[0]), "im_id": int(f[1]), "obj_id": int(f[2]), "score": float(f[3]),
+             "R": np.array(f[4].split(), float).reshape(3, 3), "t": np.array(f[5].split(), float).reshape(3, 1),
+             "time": float(f[6])} for f in (ln.split(",") for ln in lines[1:])]
+    ren = DepthRenderer({o: (m.vertices, m.faces) for o, m in meshes.items()}, W, H)
+    theirs = ref.evaluate_bop19(ests, targets, scene_gt, info, cam, depth,
+                                {o: np.asarray(m.vertices) for o, m in meshes.items()}, models_info, ren, W)
+    assert 0 < ours["bop19_ar"] < 1
+    for k in ("bop19_ar", "bop19_ar_vsd", "bop19_ar_mssd", "bop19_ar_mspd"):
+        assert ours[k] == pytest.approx(theirs[k.replace("bop19_ar", "bop19_average_recall")], abs=1e-12), k
