@@ -14,6 +14,7 @@ from scenegen.dataset.layout import object_masks_path, objects_path
 from scenegen.dataset.objects import (KeypointTruth, ModelInfo, ObjectTruth, ViewObjects, objects_arrays,
                                       objects_document)
 from scenegen.dataset.truth import TruthKind
+from scenegen.errors import SpecError
 from scenegen.spec.timeline import object_states
 
 
@@ -62,8 +63,9 @@ def keypoint_positions(built, obj) -> tuple[list[str], np.ndarray]:
             continue
         verts = vertices_object(built, obj) if verts is None else verts
         if k.vertex >= len(verts):
-            raise ValueError(f"object {obj.name!r}: keypoint {k.name!r} picks vertex {k.vertex}, but its mesh has "
-                             f"{len(verts)} vertices")
+            msg = (f"annotation.keypoints.{k.name}: expected a vertex index below {len(verts)} (the vertices of "
+                   f"{obj.name!r}'s mesh), got {k.vertex}")
+            raise SpecError.at(obj.where, msg) if obj.where is not None else ValueError(msg)
         pos.append(verts[k.vertex])
     return [k.name for k in kps], np.asarray(pos, np.float64)
 

@@ -186,3 +186,21 @@ def test_vertex_keypoints_and_models(objects_dataset):
     S = info["crate"].symmetries_discrete[0]
     np.testing.assert_allclose(S, Rigid3.from_dict({"R": np.diag([-1.0, -1, 1]).tolist(), "t": [0, 0, 0]}).matrix,
                                atol=1e-15)
+
+
+def test_a_keypoint_vertex_beyond_the_mesh_is_one_line_naming_the_spec_line(tmp_path, capsys):
+    from scenegen.cli import main
+    spec = tmp_path / "s.yaml"
+    spec.write_text("""render: {spp: 1}
+truth: {objects: true}
+cameras: {c: {size: [16, 12], fx: 15}}
+views: [{camera: c, look_at: [{eye: [0, -1, 1], target: [0, 0, 0]}]}]
+objects:
+  - name: b
+    shape: box
+    annotation: {keypoints: {k: {vertex: 24}}}
+""")
+    assert main(["render", str(spec), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "s.yaml:6" in err and "expected a vertex index below 24" in err, err
+    assert not (tmp_path / "out").exists()
