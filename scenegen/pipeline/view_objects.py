@@ -158,6 +158,20 @@ def alone_rays(built, camera, world_from_cam) -> tuple[np.ndarray, np.ndarray]:
     return d, np.isfinite(d).all(axis=1)
 
 
+def may_image(camera, cam_from_object, vertices_object) -> np.ndarray:
+    """(3H * 3W,) bool: the extended grid's pixels whose rays may meet the mesh: under a pinhole
+    with every vertex in front of the camera, those within the box of the projected vertices
+    (the projection of a triangle lies within that of its corners) and a pixel's margin; else all."""
+    W, H = camera.width, camera.height
+    P = cam_from_object.apply(vertices_object)
+    if camera.model != "pinhole" or not (P[:, 2] > 0).all():
+        return np.ones(9 * W * H, bool)
+    uv = camera.project(P)
+    lo, hi = np.floor(uv.min(axis=0)) - 1, np.ceil(uv.max(axis=0)) + 1
+    g = extended_pixels(W, H)
+    return (g[:, 0] >= lo[0]) & (g[:, 0] <= hi[0]) & (g[:, 1] >= lo[1]) & (g[:, 1] <= hi[1])
+
+
 def view_objects(spec, built, view, truth) -> ViewObjects:
     """The object truth of ``view`` (``truth``: the view's truth as stored)."""
     time_s = getattr(view, "time_s", None)
@@ -178,7 +192,8 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
         visible = ids == obj.object_id
         alone = np.zeros(len(dirs), bool)
         if present:
-            alone[ok_rays] = np.isfinite(built.alone_distances(obj.object_id, pose, world_from_cam.t, dirs[ok_rays]))
+            cast = ok_rays & may_image(camera, view.cam_from_world @ pose, vertices_object(built, obj))
+            alone[cast] = np.isfinite(built.alone_distances(obj.object_id, pose, world_from_cam.t, dirs[cast]))
         alone = alone.reshape(3 * H, 3 * W)
         # a pixel the scene's cast gives the object is covered by it: a grazing ray decided the
         # other way by the float32 rounding of the alone cast still counts (counted in the tests)
