@@ -136,6 +136,27 @@ def view_keypoints(spec, built, view, poses: dict, camera) -> dict[str, tuple[Ke
     return out
 
 
+def joint_truth(obj, poses_all: dict) -> dict | None:
+    """The joint of ``obj`` to its parent at the poses ``poses_all`` {name: world_from_object}:
+    type, unit axis and origin (parent frame) and its value, recovered from the poses:
+    ``J = parent_from_object @ rest^-1``, a revolute joint's angle about the axis (radians), a
+    prismatic joint's shift along it (metres)."""
+    a = getattr(obj, "animation", None)
+    if a is None or a.joint is None or a.parent is None:
+        return None
+    axis = np.asarray(a.joint.axis, np.float64)
+    axis = axis / np.linalg.norm(axis)
+    J = poses_all[a.parent].inverse() @ poses_all[obj.name] @ a.rest.inverse()
+    if a.joint.type == "revolute":
+        R = J.R
+        w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+        value = float(np.arctan2(axis @ w, 0.5 * (np.trace(R) - 1.0)))
+    else:
+        value = float(axis @ J.t)
+    return {"type": a.joint.type, "axis": axis.tolist(), "origin_m": [float(x) for x in a.joint.origin],
+            "value": value}
+
+
 def spec_object(spec, name: str):
     for o in spec.objects:
         if o.name == name:
@@ -186,6 +207,8 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
     poses = {o.name: o.transform.world_from_object if states is None else states[o.name].world_from_object
              for o in annotated(spec) if states is None or states[o.name].present}
     keypoints = view_keypoints(spec, built, view, poses, camera)
+    poses_all = {o.name: o.transform.world_from_object if states is None else states[o.name].world_from_object
+                 for o in spec.objects}
     for obj in annotated(spec):
         pose = obj.transform.world_from_object if states is None else states[obj.name].world_from_object
         present = obj.name in poses
@@ -202,7 +225,8 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
         objects.append(ObjectTruth(
             obj.name, obj.object_id, obj.instance_id, obj.annotation.model, mids[obj.annotation.model],
             parent_of(obj), present, view.cam_from_world @ pose, pose, obj.transform.world_from_object,
-            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), keypoints.get(obj.name, ())))
+            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), keypoints.get(obj.name, ()),
+            joint_truth(obj, poses_all)))
         masks.append(in_image_block(alone, W, H))
     return ViewObjects(view.name, (W, H), view.cam_from_world, model_infos(spec, built), tuple(objects),
                        np.asarray(masks, bool).reshape(len(objects), H, W))
