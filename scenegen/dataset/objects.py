@@ -12,7 +12,8 @@ asks (``truth: {objects: true}``) for every object with an ``annotation:``:
   ``visib_fract`` their ratio (0 when the silhouette covers none); ``box_obj_xyxy_px`` and
   ``box_visib_xyxy_px``: the inclusive ranges ``[u_min, v_min, u_max, v_max]`` of the OpenCV
   pixel centres of those pixels (the first may lie beyond the image; null when none); its
-  keypoints (object frame, projected ``uv_px``, ``depth_z_m``, ``state``); and per model its
+  keypoints (object frame, projected ``uv_px``, ``depth_z_m``, ``state``), its joint to its
+  parent (type, axis, origin, value at the view's time; null without one); and per model its
   diameter and declared symmetries (BOP's ``models_info`` form, metres) and skeleton.
 * ``truth/<view>_objects.npz``: ``object_ids`` (N,) uint32 in the JSON's order and
   ``mask_full_bits`` (N, H, ceil(W / 8)) uint8, each object's full (amodal) mask packed along rows
@@ -62,6 +63,8 @@ class ObjectTruth:
     box_obj_xyxy_px: tuple[int, int, int, int] | None  # the silhouette's pixel centres (extended grid)
     box_visib_xyxy_px: tuple[int, int, int, int] | None  # the visible pixels' centres
     keypoints: tuple[KeypointTruth, ...]
+    joint: dict | None = None  # the joint to its parent: {type, axis, origin_m (parent frame),
+    # value (radians for revolute, metres for prismatic) at the view's time}; None without one
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,6 +124,7 @@ def objects_document(v: ViewObjects) -> dict:
             "keypoints": [{"name": k.name, "position_object_m": k.position_object_m.tolist(),
                            "uv_px": [_num(x) for x in k.uv_px], "depth_z_m": _num(k.depth_z_m), "state": k.state}
                           for k in o.keypoints],
+            "joint": o.joint,
         } for o in v.objects],
     }
 
@@ -190,7 +194,21 @@ def _object(d, where: str) -> ObjectTruth:
                        _rigid(d, "world_from_mesh_object", where), ints[3], ints[4], fract,
                        _box(d.get("box_obj_xyxy_px"), f"{where}.box_obj_xyxy_px"),
                        _box(d.get("box_visib_xyxy_px"), f"{where}.box_visib_xyxy_px"),
-                       tuple(_keypoint(k, f"{where}.keypoints[{i}]") for i, k in enumerate(kps)))
+                       tuple(_keypoint(k, f"{where}.keypoints[{i}]") for i, k in enumerate(kps)),
+                       _joint(d.get("joint"), f"{where}.joint"))
+
+
+def _joint(j, where: str) -> dict | None:
+    if j is None:
+        return None
+    try:
+        out = {"type": str(j["type"]), "axis": [float(x) for x in j["axis"]],
+               "origin_m": [float(x) for x in j["origin_m"]], "value": float(j["value"])}
+    except (KeyError, TypeError, ValueError):
+        raise ValueError(f"{where}: expected null or {{type, axis, origin_m, value}}") from None
+    if len(out["axis"]) != 3 or len(out["origin_m"]) != 3 or not np.isfinite(out["value"]):
+        raise ValueError(f"{where}: expected 3-vectors axis, origin_m and a finite value")
+    return out
 
 
 def _model(d, where: str) -> ModelInfo:

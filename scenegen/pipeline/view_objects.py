@@ -14,6 +14,7 @@ from scenegen.dataset.layout import object_masks_path, objects_path
 from scenegen.dataset.objects import (KeypointTruth, ModelInfo, ObjectTruth, ViewObjects, objects_arrays,
                                       objects_document)
 from scenegen.dataset.truth import TruthKind
+from scenegen.errors import SpecError
 from scenegen.spec.timeline import object_states
 
 
@@ -62,8 +63,9 @@ def keypoint_positions(built, obj) -> tuple[list[str], np.ndarray]:
             continue
         verts = vertices_object(built, obj) if verts is None else verts
         if k.vertex >= len(verts):
-            raise ValueError(f"object {obj.name!r}: keypoint {k.name!r} picks vertex {k.vertex}, but its mesh has "
-                             f"{len(verts)} vertices")
+            msg = (f"annotation.keypoints.{k.name}: expected a vertex index below {len(verts)} (the vertices of "
+                   f"{obj.name!r}'s mesh), got {k.vertex}")
+            raise SpecError.at(obj.where, msg) if obj.where is not None else ValueError(msg)
         pos.append(verts[k.vertex])
     return [k.name for k in kps], np.asarray(pos, np.float64)
 
@@ -134,6 +136,27 @@ def view_keypoints(spec, built, view, poses: dict, camera) -> dict[str, tuple[Ke
     return out
 
 
+def joint_truth(obj, poses_all: dict) -> dict | None:
+    """The joint of ``obj`` to its parent at the poses ``poses_all`` {name: world_from_object}:
+    type, unit axis and origin (parent frame) and its value, recovered from the poses:
+    ``J = parent_from_object @ rest^-1``, a revolute joint's angle about the axis (radians), a
+    prismatic joint's shift along it (metres)."""
+    a = getattr(obj, "animation", None)
+    if a is None or a.joint is None or a.parent is None:
+        return None
+    axis = np.asarray(a.joint.axis, np.float64)
+    axis = axis / np.linalg.norm(axis)
+    J = poses_all[a.parent].inverse() @ poses_all[obj.name] @ a.rest.inverse()
+    if a.joint.type == "revolute":
+        R = J.R
+        w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+        value = float(np.arctan2(axis @ w, 0.5 * (np.trace(R) - 1.0)))
+    else:
+        value = float(axis @ J.t)
+    return {"type": a.joint.type, "axis": axis.tolist(), "origin_m": [float(x) for x in a.joint.origin],
+            "value": value}
+
+
 def spec_object(spec, name: str):
     for o in spec.objects:
         if o.name == name:
@@ -156,6 +179,20 @@ def alone_rays(built, camera, world_from_cam) -> tuple[np.ndarray, np.ndarray]:
     return d, np.isfinite(d).all(axis=1)
 
 
+def may_image(camera, cam_from_object, vertices_object) -> np.ndarray:
+    """(3H * 3W,) bool: the extended grid's pixels whose rays may meet the mesh: under a pinhole
+    with every vertex in front of the camera, those within the box of the projected vertices
+    (the projection of a triangle lies within that of its corners) and a pixel's margin; else all."""
+    W, H = camera.width, camera.height
+    P = cam_from_object.apply(vertices_object)
+    if camera.model != "pinhole" or not (P[:, 2] > 0).all():
+        return np.ones(9 * W * H, bool)
+    uv = camera.project(P)
+    lo, hi = np.floor(uv.min(axis=0)) - 1, np.ceil(uv.max(axis=0)) + 1
+    g = extended_pixels(W, H)
+    return (g[:, 0] >= lo[0]) & (g[:, 0] <= hi[0]) & (g[:, 1] >= lo[1]) & (g[:, 1] <= hi[1])
+
+
 def view_objects(spec, built, view, truth) -> ViewObjects:
     """The object truth of ``view`` (``truth``: the view's truth as stored)."""
     time_s = getattr(view, "time_s", None)
@@ -170,13 +207,16 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
     poses = {o.name: o.transform.world_from_object if states is None else states[o.name].world_from_object
              for o in annotated(spec) if states is None or states[o.name].present}
     keypoints = view_keypoints(spec, built, view, poses, camera)
+    poses_all = {o.name: o.transform.world_from_object if states is None else states[o.name].world_from_object
+                 for o in spec.objects}
     for obj in annotated(spec):
         pose = obj.transform.world_from_object if states is None else states[obj.name].world_from_object
         present = obj.name in poses
         visible = ids == obj.object_id
         alone = np.zeros(len(dirs), bool)
         if present:
-            alone[ok_rays] = np.isfinite(built.alone_distances(obj.object_id, pose, world_from_cam.t, dirs[ok_rays]))
+            cast = ok_rays & may_image(camera, view.cam_from_world @ pose, vertices_object(built, obj))
+            alone[cast] = np.isfinite(built.alone_distances(obj.object_id, pose, world_from_cam.t, dirs[cast]))
         alone = alone.reshape(3 * H, 3 * W)
         # a pixel the scene's cast gives the object is covered by it: a grazing ray decided the
         # other way by the float32 rounding of the alone cast still counts (counted in the tests)
@@ -185,7 +225,8 @@ def view_objects(spec, built, view, truth) -> ViewObjects:
         objects.append(ObjectTruth(
             obj.name, obj.object_id, obj.instance_id, obj.annotation.model, mids[obj.annotation.model],
             parent_of(obj), present, view.cam_from_world @ pose, pose, obj.transform.world_from_object,
-            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), keypoints.get(obj.name, ())))
+            n_all, n_vis, fract, mask_box(alone, (-W, -H)), mask_box(visible), keypoints.get(obj.name, ()),
+            joint_truth(obj, poses_all)))
         masks.append(in_image_block(alone, W, H))
     return ViewObjects(view.name, (W, H), view.cam_from_world, model_infos(spec, built), tuple(objects),
                        np.asarray(masks, bool).reshape(len(objects), H, W))

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from scenegen.dataset import Dataset
 from scenegen.export import export
@@ -104,6 +105,9 @@ def test_models_and_models_info(exported):
     crate, can = info[1], info[2]
     S = np.reshape(crate["symmetries_discrete"][0], (4, 4))  # as misc.get_symmetry_transformations reads it
     np.testing.assert_allclose(S[:3, :3], np.diag([-1.0, -1.0, 1.0]), atol=1e-15)
+    pts = bop.load_ply(dest / "models" / "obj_000001.ply")["pts"]
+    moved = pts @ S[:3, :3].T + S[:3, 3]
+    assert cKDTree(pts).query(moved)[0].max() < 1e-4  # the declared symmetry maps the model onto itself (mm)
     assert can["symmetries_continuous"] == [{"axis": [0.0, 0.0, 1.0], "offset": [0.0, 0.0, 10.0]}]
     assert "symmetries_discrete" not in can and "symmetries_continuous" not in info[3]
 

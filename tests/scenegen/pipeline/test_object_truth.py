@@ -186,3 +186,36 @@ def test_vertex_keypoints_and_models(objects_dataset):
     S = info["crate"].symmetries_discrete[0]
     np.testing.assert_allclose(S, Rigid3.from_dict({"R": np.diag([-1.0, -1, 1]).tolist(), "t": [0, 0, 0]}).matrix,
                                atol=1e-15)
+
+
+def test_a_keypoint_vertex_beyond_the_mesh_is_one_line_naming_the_spec_line(tmp_path, capsys):
+    from scenegen.cli import main
+    spec = tmp_path / "s.yaml"
+    spec.write_text("""render: {spp: 1}
+truth: {objects: true}
+cameras: {c: {size: [16, 12], fx: 15}}
+views: [{camera: c, look_at: [{eye: [0, -1, 1], target: [0, 0, 0]}]}]
+objects:
+  - name: b
+    shape: box
+    annotation: {keypoints: {k: {vertex: 24}}}
+""")
+    assert main(["render", str(spec), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "s.yaml:6" in err and "expected a vertex index below 24" in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_joint_values_equal_the_spec_keyframes_at_keyframe_times(figure_dataset):
+    """scenes/articulated_figure.yaml keyframes its joints at 0 and 0.2 s: frames 0 and 2. The
+    angles recovered from the stored poses equal the keyframe values (degrees in the spec)."""
+    ds = Dataset(figure_dataset)
+    expected = {"upper_arm_l": (0, 100), "forearm_l": (10, 60), "upper_arm_r": (-10, -30), "forearm_r": (20, 70),
+                "thigh_l": (0, 35), "shin_l": (0, -50)}
+    first, last = ds.objects(ds.views[0]), ds.objects(ds.views[2])
+    for name, (a0, a1) in expected.items():
+        for objs, deg in ((first, a0), (last, a1)):
+            j = objs.by_name(name).joint
+            assert j["type"] == "revolute" and j["axis"] == [1.0, 0.0, 0.0]
+            assert j["value"] == pytest.approx(np.radians(deg), abs=1e-12), name
+    assert first.by_name("torso").joint is None and first.by_name("torso").parent == "pelvis"
