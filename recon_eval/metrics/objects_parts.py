@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from recon_eval.metrics.objects_bop import SymmetryTransforms, add, rot_trans_error
 from scenegen.geometry.rotation import rotation_error_rad
@@ -100,3 +101,22 @@ def joint_rotation_errors(est: dict, gt: dict, parents: dict) -> dict:
         rel_g = np.asarray(gt[parent][0]).T @ np.asarray(gt[child][0])
         out[child] = float(np.degrees(rotation_error_rad(rel_e, rel_g)))
     return out
+
+
+def twist_angle_rad(R, axis) -> float:
+    """The signed angle about unit ``axis`` of rotation ``R`` (3, 3): the twist of its
+    swing-twist decomposition, ``2 atan2(q_v . axis, q_w)`` wrapped to [-pi, pi)."""
+    q = Rotation.from_matrix(np.asarray(R, dtype=np.float64)).as_quat()  # x, y, z, w
+    a = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
+    ang = 2.0 * np.arctan2(float(q[:3] @ a), float(q[3]))
+    return float((ang + np.pi) % (2 * np.pi) - np.pi)
+
+
+def recovered_joint_angle_rad(R_parent_est, R_child_est, R_parent_gt, R_child_gt, axis, value_gt_rad: float) -> float:
+    """A revolute joint's angle recovered from estimated part poses (``cam_from_part``): the truth
+    angle plus the twist about the joint ``axis`` (parent frame) of the estimated relative rotation
+    against the truth's, ``(R_p^T R_c)_est (R_p^T R_c)_gt^T``: the joint turns the child about the
+    axis in the parent's frame, so the rest rotation cancels."""
+    rel_e = np.asarray(R_parent_est).T @ np.asarray(R_child_est)
+    rel_g = np.asarray(R_parent_gt).T @ np.asarray(R_child_gt)
+    return value_gt_rad + twist_angle_rad(rel_e @ rel_g.T, axis)

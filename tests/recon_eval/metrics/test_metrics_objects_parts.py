@@ -6,7 +6,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from recon_eval.metrics.objects_bop import symmetry_transforms
-from recon_eval.metrics.objects_parts import articulated_pose_errors, joint_rotation_errors, pck
+from recon_eval.metrics.objects_parts import (
+    articulated_pose_errors, joint_rotation_errors, pck, recovered_joint_angle_rad, twist_angle_rad,
+)
 
 
 def test_pck_counts_labelled_keypoints_within_alpha_size():
@@ -45,3 +47,16 @@ def test_joint_rotation_error_is_the_joint_angle_difference():
     est = {"torso": (base, t), "arm": (base @ axis_angle(37), t)}
     e = joint_rotation_errors(est, gt, {"arm": "torso", "hand": "arm", "torso": None})
     assert e["arm"] == pytest.approx(7.0) and e["hand"] == np.inf and "torso" not in e
+
+
+def test_recovered_joint_angle_is_the_twist_about_the_axis():
+    axis = np.array([0.0, 0.6, 0.8])
+    rest = Rotation.from_rotvec([0.3, 0.1, -0.2]).as_matrix()  # the child's rest rotation in the parent
+    turn = lambda rad: Rotation.from_rotvec(rad * axis).as_matrix()  # noqa: E731
+    parent_gt = Rotation.from_rotvec([0.5, -0.2, 0.1]).as_matrix()
+    parent_est = Rotation.from_rotvec([0.1, 0.4, 0.3]).as_matrix()  # a wrong parent: the joint is relative
+    child_gt = parent_gt @ turn(0.7) @ rest
+    child_est = parent_est @ turn(0.7 + 0.25) @ rest
+    assert recovered_joint_angle_rad(parent_est, child_est, parent_gt, child_gt, axis, 0.7) == pytest.approx(0.95)
+    assert twist_angle_rad(turn(-3.0), axis) == pytest.approx(-3.0)
+    assert twist_angle_rad(Rotation.from_rotvec([0.4, 0, 0]).as_matrix(), [0, 0, 1]) == pytest.approx(0.0)
