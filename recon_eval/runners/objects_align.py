@@ -33,6 +33,7 @@ SEED = 0
 def _o3d():
     import open3d as o3d  # heavy optional dependency (the `runners` extra): only these runners need it
 
+    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)  # its per-registration warnings
     return o3d
 
 
