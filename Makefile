@@ -32,7 +32,7 @@ llvm:
 $(VENV)/.installed: pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev]'
+	$(BIN)/pip install -q -e '.[dev,runners]'
 	touch $@
 
 setup: llvm $(VENV)/.installed

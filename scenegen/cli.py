@@ -27,7 +27,7 @@ RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 #: ``export --format`` choices: scenegen.export.FORMATS (equal, tests/scenegen/test_cli.py)
 EXPORT_FORMATS = ("colmap", "gaussian-splatting", "nerf", "kitti-stereo", "middlebury", "opencv", "tum", "tapvid",
                   "tracks-video", "kitti-flow", "kitti-sceneflow", "sintel", "euroc",
-                  "kitti-velodyne", "nuscenes-lidar", "lidar-pcd", "lidar-ply", "kitti-odometry", "tof")
+                  "kitti-velodyne", "nuscenes-lidar", "lidar-pcd", "lidar-ply", "kitti-odometry", "tof", "bop", "coco")
 #: Verbosity: -q 0, default 1, -v 2.
 QUIET, NORMAL, VERBOSE = 0, 1, 2
 

@@ -41,6 +41,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("tracks", "point tracks over a sequence: TAP-Vid AJ, < delta_avg, OA against the truth tracks", "tracks"),
     Command("normals", "normal maps (photometric stereo): DiLiGenT mean/median angular error, < 10/20/30 deg; "
                        "albedo up to scale; light directions", "photometric"),
+    Command("objects", "6D object poses (BOP19 CSV) and keypoints (COCO results): BOP19 AR (VSD, MSSD, MSPD), "
+                       "ADD/ADD-S recall, COCO keypoint AP, PCK", "objects"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
     Command("sweep", "F, H, E, PnP or triangulation estimators over noise and outliers on exact truth: per-cell "
                      "error statistics, breakdown points", "sweep",

@@ -25,7 +25,7 @@ DIRECTIONS = (
     (re.compile(r"^(?!abs_).*signed"), None),
     (re.compile(r"failure|invalid|outlier"), False),
     (re.compile(r"recall|precision|ratio|mma|repeatab|matching_score|accuracy|auc|fscore|f_score|^f1$|"
-                r"completeness|^n_|^a[123]$|registered|inlier|^within_|coverage"), True),
+                r"completeness|^n_|^a[123]$|registered|inlier|^within_|coverage|^bop19_ar|^coco_kp_a[pr]|^pck"), True),
     (re.compile(r"err|rms|bad_|dist|mace|mae|epe|abs_rel|sq_rel|^fl_|_pct$|_px$|_deg$|_m$|chamfer|sampson"), False),
 )
 

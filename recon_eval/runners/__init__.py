@@ -71,7 +71,9 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("external_views", "pnp"): "absolute pose (PnP)", ("external_views", "normals"): "photometric stereo",
          ("external_views", "cloud"): "point clouds and meshes", ("external_views", "triangulation"): "triangulation",
          ("external_views", "dlt"): "DLT camera matrices", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
-         ("external_sequence", "trajectory"): "camera trajectory"}
+         ("external_sequence", "trajectory"): "camera trajectory",
+         ("objects_align", None): "6D object pose (BOP)", ("objects_features", None): "6D object pose (BOP)",
+         ("objects_parts", None): "articulated object pose"}
 
 
 def _m(name, module, function, description, **options):
@@ -141,6 +143,15 @@ METHODS: dict[str, Method] = {m.name: m for m in [
        "shape from texture: slant and tilt of a textured plane from its mean normalised structure tensor "
        "(isotropic texture, orthographic foreshortening), tilt sign from the texture's density gradient",
        window_px=4.0),
+    _m("o3d-fpfh-ransac-icp", "objects_align", "run",
+       "alignment: Open3D FPFH + RANSAC global registration of each model to each depth cluster (table plane "
+       "removed, DBSCAN), point-to-plane ICP, 4 trials verified by rendered depth; BOP19 CSV"),
+    _m("sift-pnp-ransac", "objects_features", "run",
+       "invariant features: SIFT matches from the reference renders (train split) of each model to the image, "
+       "cv2.solvePnPRansac (EPnP + refinement); BOP19 CSV"),
+    _m("parts-align-joints", "objects_parts", "run",
+       "parts: each part of an articulated object posed alone by the alignment method, joints recovered as the "
+       "parts' relative rotations; BOP19 CSV, per-part and joint errors"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.

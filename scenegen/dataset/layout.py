@@ -18,6 +18,8 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_lights.json                the lights on in the view, camera frame (spec truth.lights)
     truth/<view>_coc.exr                    thin-lens circle of confusion per pixel (channel coc_radius_px; truth.defocus)
     truth/<view>_boxes.json                 2D and 3D bounding boxes per object (truth.boxes)
+    truth/<view>_objects.json               annotated objects: poses, visible fraction, keypoints (truth.objects)
+    truth/<view>_objects.npz                their full (amodal) masks, packed bits (truth.objects)
     raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
     images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote
@@ -55,7 +57,7 @@ MAX_NAME_LEN = 128
 #: A view name may not end like another view's suffixed files (view "a_ids" would clash with
 #: view "a"'s truth/a_ids.exr).
 RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw", "_albedo", "_lights", "_coc",
-                          "_boxes")
+                          "_boxes", "_objects")
 MATCH_KINDS = ("synthetic", "sift")
 
 CROSSVIEW = "crossview"
@@ -176,6 +178,20 @@ BOXES_TEMPLATE = "truth/{view}_boxes.json"
 def boxes_path(view: str) -> str:
     """The 2D and 3D bounding boxes of every object in a view (an extra file of the view)."""
     return BOXES_TEMPLATE.format(view=check_view_name(view))
+
+
+OBJECTS_TEMPLATE = "truth/{view}_objects.json"
+OBJECT_MASKS_TEMPLATE = "truth/{view}_objects.npz"
+
+
+def objects_path(view: str) -> str:
+    """The annotated objects' truth of a view (an extra file of the view)."""
+    return OBJECTS_TEMPLATE.format(view=check_view_name(view))
+
+
+def object_masks_path(view: str) -> str:
+    """The annotated objects' full masks of a view (an extra file of the view)."""
+    return OBJECT_MASKS_TEMPLATE.format(view=check_view_name(view))
 
 
 #: The raw mosaic of a view of a camera with ``imaging.raw`` (templates recorded in cameras.json).

@@ -19,10 +19,12 @@ from pathlib import Path
 import numpy as np
 
 from scenegen.dataset.boxes import ViewBoxes, decode_boxes
+from scenegen.dataset.objects import ViewObjects, decode_objects
 from scenegen.dataset.cameras import camera_of
 from scenegen.dataset.codecs.dng import read_dng
 from scenegen.dataset.codecs.exr import read_exr, unpack_channels
 from scenegen.dataset.codecs.json import read_json
+from scenegen.dataset.codecs.npy import read_npz
 from scenegen.dataset.codecs.ply import read_ply
 from scenegen.dataset.codecs.png import read_png
 from scenegen.dataset.crossview_reader import CrossviewTruth
@@ -35,6 +37,8 @@ from scenegen.dataset.layout import (
     COC_CHANNEL,
     albedo_path,
     boxes_path,
+    object_masks_path,
+    objects_path,
     check_listed_names,
     coc_path,
     check_rel_path,
@@ -276,6 +280,17 @@ class Dataset:
         rel = boxes_path(self.check_view(view))
         return self.read(rel, lambda p: decode_boxes(read_json(p), str(p)), f"boxes of view {view!r}") \
             if self.has(rel) else None
+
+    def objects(self, view: str) -> ViewObjects | None:
+        """The annotated objects' truth in a view (:class:`scenegen.dataset.objects.ViewObjects`:
+        poses, visible fraction, full masks, keypoints, models), or None when the spec did not
+        ask for it (``truth: {objects: true}``)."""
+        rel = objects_path(self.check_view(view))
+        if not self.has(rel):
+            return None
+        arrays = self.read(object_masks_path(view), lambda p: read_npz(p, ("object_ids", "mask_full_bits")),
+                           f"object masks of view {view!r}")
+        return self.read(rel, lambda p: decode_objects(read_json(p), arrays, str(p)), f"object truth of view {view!r}")
 
     def raw(self, view: str, kind: str | None = None) -> RawImage | None:
         """The raw mosaic of a view (:class:`scenegen.dataset.raw.RawImage`: uint16 DN, CFA,

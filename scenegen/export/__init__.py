@@ -28,12 +28,18 @@ imports Mitsuba. Formats (docs/crossview.md, "Exports"):
   KITTI ``.bin``, nuScenes ``.pcd.bin``, PCD and PLY point clouds (:mod:`.lidar`).
 * ``tof``: a ToF stream's raw frames as 16-bit PNG and float32 EXR (with its truth) and its
   calibration JSON (intrinsics, frequencies, phase offsets, extrinsic, poses).
+* ``bop``: BOP's scenewise layout (scene_gt, scene_gt_info, scene_camera, rgb/, depth/, mask/,
+  mask_visib/, models/ with models_info.json, in mm) from the object truth;
+* ``coco``: COCO instances and keypoints (annotations.json: RLE masks, boxes, keypoints with
+  visibility, categories with skeletons) + images/, from the object truth.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from scenegen.export import (
+    bop,
+    coco,
     colmap,
     euroc,
     gaussian_splatting,
@@ -62,14 +68,15 @@ FORMATS = {"colmap": colmap.export, "gaussian-splatting": gaussian_splatting.exp
            "kitti-flow": kitti_flow.export, "kitti-sceneflow": kitti_sceneflow.export, "sintel": sintel.export,
            "euroc": euroc.export, "kitti-velodyne": lidar.export_kitti, "nuscenes-lidar": lidar.export_nuscenes,
            "lidar-pcd": lidar.export_pcd, "lidar-ply": lidar.export_ply,
-           "kitti-odometry": kitti_odometry.export, "tof": tof.export}
+           "kitti-odometry": kitti_odometry.export, "tof": tof.export, "bop": bop.export,
+           "coco": coco.export}
 #: What each exporter's progress counts.
 PROGRESS_UNITS = {"colmap": "reference views", "gaussian-splatting": "views", "nerf": "views",
                   "kitti-stereo": "stereo frames", "middlebury": "stereo frames", "opencv": "views", "tum": "views",
                   "tapvid": "streams", "tracks-video": "streams", "kitti-flow": "frame pairs",
                   "kitti-sceneflow": "stereo frame pairs", "sintel": "views",
                   "euroc": "views", "kitti-velodyne": "sweeps", "nuscenes-lidar": "sweeps", "lidar-pcd": "sweeps",
-                  "lidar-ply": "sweeps", "kitti-odometry": "stereo frames", "tof": "streams"}
+                  "lidar-ply": "sweeps", "kitti-odometry": "stereo frames", "tof": "streams", "bop": "views", "coco": "views"}
 
 
 def default_dest(out_dir, fmt: str) -> Path:

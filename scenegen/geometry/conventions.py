@@ -27,7 +27,8 @@ Foreign conventions, one function (or constant) each:
   the box of the pixels whose centres span ``[u_min, u_max] x [v_min, v_max]`` is
   ``[u_min, v_min, u_max - u_min + 1, v_max - v_min + 1]`` (``coco_box_of_pixels``); an extent of
   OpenCV positions is ``[u_min + 0.5, v_min + 0.5, u_max - u_min, v_max - v_min]``
-  (``coco_box_of_extent``).
+  (``coco_box_of_extent``). COCO keypoints and run-length masks are in the same frame:
+  ``coco = opencv + 0.5`` (``coco_points``); a mask's RLE runs down the columns (Fortran order).
 * 3D box corners: corner k of a box with centre c and size s is ``c + BOX_CORNER_SIGNS[k] * s / 2``,
   the signs (-1, +1) in itertools.product order (x slowest, z fastest).
 * Mitsuba film: sample position s in [0, 1]^2 over the image, pixel i covers [i, i + 1] in film
@@ -217,6 +218,11 @@ def coco_box_of_extent(box_xyxy) -> list[float]:
     positions (``coco = opencv + 0.5``, like COLMAP's)."""
     u0, v0, u1, v1 = (float(x) for x in box_xyxy)
     return [u0 + 0.5, v0 + 0.5, u1 - u0, v1 - v0]
+
+
+def coco_points(uv) -> np.ndarray:
+    """(N, 2) COCO keypoint positions (pixel edges) of OpenCV positions (N, 2): ``uv + 0.5``."""
+    return np.asarray(uv, np.float64) + 0.5
 
 
 # --- depth vs range ---------------------------------------------------------------------------

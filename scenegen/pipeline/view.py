@@ -23,6 +23,7 @@ from scenegen.dataset.layout import COC_CHANNEL, albedo_path, coc_path, lights_p
 from scenegen.dataset.photometric import encode_albedo
 from scenegen.imaging.stage import apply_imaging
 from scenegen.pipeline.view_boxes import view_boxes_file
+from scenegen.pipeline.view_objects import view_objects_files
 from scenegen.spec.light_truth import view_lights_document
 from scenegen.spec.timeline import poses_within_frame
 
@@ -160,7 +161,7 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
         image, extra = apply_imaging(linear, params, built.cameras[v.camera], spec.seed, index, v.name,
                                      camera_name=v.camera)
     if spec.truth is not None and (spec.truth.albedo or spec.truth.lights or spec.truth.defocus
-                                   or spec.truth.boxes):
+                                   or spec.truth.boxes or spec.truth.objects):
         extra = {**(extra or {}), **requested_truth_files(spec, built, v, truth)}
     return image, linear, truth, extra
 
@@ -187,6 +188,10 @@ def requested_truth_files(spec, built, view, truth) -> dict[str, bytes]:
     if spec.truth.boxes:  # from the ids as stored and the meshes (docs/dataset_format.md, "Bounding boxes")
         rel, data = view_boxes_file(spec, built, view, truth)
         files[rel] = data
+    if spec.truth.objects:  # poses, masks cast alone, keypoints (docs/dataset_format.md, "Object truth")
+        if rolling_shutter_rows(built, view) is not None:
+            raise ValueError(f"view {view.name!r}: object truth is for a global shutter (each object at one pose)")
+        files.update(view_objects_files(spec, built, view, truth))
     return files
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast
 from scenegen.render.albedo import albedo_pass
+from scenegen.render.alone import alone_distances
 from scenegen.render.beams import cast_at_times
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
@@ -121,6 +122,16 @@ class Caster:
         rays (N, 3) each cast at its own time (N,) s with the moving objects there
         (:func:`scenegen.render.beams.cast_at_times`: a LiDAR's beams)."""
         return cast_at_times(self.device, origins_world, directions_world, times_s)
+    def alone_distances(self, object_id: int, world_from_object: Rigid3, origin_world, directions_world) -> np.ndarray:
+        """(N,) float64 distances along unit rays to one object alone at ``world_from_object``
+        (+inf: missed; :func:`scenegen.render.alone.alone_distances`)."""
+        return alone_distances(self.device, object_id, world_from_object, origin_world, directions_world)
+
+    def first_hit_distance(self, origin_world, directions_world, *, time_s: float | None = None) -> np.ndarray:
+        """(N,) float64 distances along unit rays to the first surface of the scene at ``time_s``
+        (+inf: missed; :func:`scenegen.render.raycast.first_hit_distance`)."""
+        dev = self._at(time_s)
+        return raycast.first_hit_distance(dev.scene, origin_world, directions_world, dev.alpha_masked)[0]
 
     def _at(self, time_s: float | None) -> DeviceScene:
         self.device.place_at(time_s)

@@ -45,6 +45,8 @@ class DeviceScene:
     time_s: float | None = None  # device state: the clock time the animated objects are at
     animated_params: object = None  # mi.traverse of the scene, made on the first placement
     timed_scenes: TimedScenes | None = field(default=None, repr=False)  # made on first use (:meth:`timed`)
+    alone_scenes: dict = field(default_factory=dict, repr=False)  # object id -> (its scene alone,
+    # world_from_ref), made on first use (:mod:`scenegen.render.alone`)
 
     # read-only views of the description, for the modules that render (frames, lights, animate)
     @property

@@ -22,6 +22,7 @@ from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.imaging import ImagingParams
 from scenegen.spec import model as m
 from scenegen.spec.load import parse_spec
+from scenegen.spec.parse.annotation import annotation_to_yaml
 from scenegen.spec.parse.fields import plain_value, write_fields
 from scenegen.spec.parse.imaging import BLOCKS
 from scenegen.spec.parse.optics import OPTICS_KEYS
@@ -105,6 +106,8 @@ def _object(obj: m.SceneObject, materials) -> dict:
     d["instance_id"] = obj.instance_id
     if obj.motion is not None:
         d["motion"] = write_fields(obj.motion)
+    if obj.annotation is not None:
+        d["annotation"] = annotation_to_yaml(obj.annotation)
     if obj.animation is not None:
         d.update(_animation(obj.animation, _v(obj.transform.scale)))
         if obj.animation.trajectory is not None:  # the keyframes place it; `transform` scales only

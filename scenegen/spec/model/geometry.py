@@ -205,4 +205,7 @@ class SceneObject:
                                      "(trajectory, parent, joint, visible_s); None = static. With "
                                      "one, `transform` is the object's pose at frame 0",
                           omit_default=True)
+    annotation: Any = part(None, unit="scenegen.spec.model.annotation.Annotation: the model it is an "
+                                      "instance of, symmetries, keypoints, skeleton; None = not annotated",
+                           omit_default=True)
     where: Where | None = where_field()

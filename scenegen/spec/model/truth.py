@@ -20,4 +20,7 @@ class TruthSpec:
     # thin-lens circle of confusion of each pixel's truth point (cameras with a `lens:`)
     boxes: bool = param(False, unit="flag", omit_default=True)  # truth/<view>_boxes.json: every
     # object's visible and amodal 2D boxes and its 3D box in the object frame, with its poses
+    objects: bool = param(False, unit="flag", omit_default=True)  # truth/<view>_objects.json and
+    # _objects.npz: every annotated object's pose, visible fraction, visible and full masks and
+    # boxes, keypoints with their visibility (objects with an `annotation:`)
     where: Where | None = where_field()

@@ -11,6 +11,7 @@ from scenegen.geometry.conventions import mesh_up_axis
 from scenegen.located_yaml import Fields, Node, suggest
 from scenegen.spec.model import geometry as mg
 from scenegen.spec.model.materials import DiffuseMaterial, Material
+from scenegen.spec.parse.annotation import parse_annotation
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.fields import check_keys, read_fields
 from scenegen.spec.parse.library import library_model
@@ -30,7 +31,7 @@ TARGET_CLASSES = {"checkerboard": mg.CheckerboardTarget, "charuco": mg.CharucoTa
 def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
     f = node.as_mapping("an object (a mapping with 'name' and one of shape, mesh, target)")
     f.check(required=("name",),
-            optional=("shape", "mesh", "target", "transform", "material", "instance_id", "motion")
+            optional=("shape", "mesh", "target", "transform", "material", "instance_id", "motion", "annotation")
             + ANIMATION_KEYS)
     name = f.get("name").as_name("an object name")
     which = f.one_of(("shape", "mesh", "target"))
@@ -48,7 +49,9 @@ def parse_object(node: Node, index: int, ctx: ParseContext) -> mg.SceneObject:
     return mg.SceneObject(name=name, geometry=geometry, transform=transform, material=material,
                           object_id=object_id, instance_id=instance_id,
                           motion=parse_motion(f.get("motion")) if "motion" in f else None,
-                          animation=animation, where=node.where)
+                          animation=animation,
+                          annotation=parse_annotation(f.get("annotation"), name) if "annotation" in f else None,
+                          where=node.where)
 
 
 def parse_mesh(node: Node, mat_node: Node | None, ctx: ParseContext) -> mg.Mesh:

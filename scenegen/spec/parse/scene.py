@@ -19,6 +19,7 @@ from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.crossview import check_pair_views, parse_crossview
 from scenegen.spec.parse.lights import parse_light
 from scenegen.spec.parse.materials import parse_material
+from scenegen.spec.parse.annotation import check_annotations
 from scenegen.spec.parse.objects import parse_object
 from scenegen.spec.parse.placement import check_variation, parse_placement
 from scenegen.spec.parse.read import read_int
@@ -65,6 +66,8 @@ def parse_document(doc: Document) -> SceneSpec:
     for i, item in enumerate(f.get("objects").items("a list of objects") if "objects" in f else []):
         objects.append(parse_object(item, i, ctx.but(objects=tuple(objects))))
     unique_names(f.get("objects"), objects, "object")
+    if any(o.annotation is not None for o in objects):
+        check_annotations(objects, f.get("objects"))
     ctx = ctx.but(objects=tuple(objects))
     placement = None
     if "placement" in f:  # the dropped objects at their settled poses from here on
@@ -88,6 +91,9 @@ def parse_document(doc: Document) -> SceneSpec:
         rigs=ctx.rigs, sensors=ctx.sensors, view_sets=tuple(view_sets), file=doc.file, base_dir=doc.base_dir,
         warnings=tuple(ctx.warnings), crossview=crossview, variation=variation, sequence=sequence,
         truth=truth, placement=placement)
+    if truth is not None and truth.objects and not any(o.annotation is not None for o in ctx.objects):
+        raise f.get("truth").as_mapping().get("objects").error(
+            "object truth is written for objects with an `annotation:`; no object has one")
     if truth is not None and truth.albedo:
         moving = [o.name for o in objects if o.motion is not None and not o.motion.is_static] + \
                  [vs.prefix for vs in view_sets if vs.motion is not None and not vs.motion.is_static]

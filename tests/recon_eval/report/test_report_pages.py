@@ -116,7 +116,8 @@ def test_one_failed_invocation_is_one_row_and_the_inputs_are_words_not_reprs():
     ("views_used_ratio", True), ("abs_median_signed_err_px", False), ("sigma1.median_rel_err", False),
     ("localisation_err_px", False), ("calib_rms_px", False), ("median_signed_err_px", None),
     ("description", None), ("lambertian.within_10deg", True), ("all.albedo_rel_mae", False), ("coverage", True),
-    ("lambertian.mean_ae_deg", False),
+    ("lambertian.mean_ae_deg", False), ("bop19_ar", True), ("bop19_ar_mspd", True), ("coco_kp_ap50", True),
+    ("pck_10", True), ("median_joint_rot_err_deg", False),
 ])
 def test_direction_of_the_leaderboard_metrics(metric, higher):
     assert higher_is_better(metric) is higher

@@ -168,6 +168,8 @@ CASES = [
                    ("near_miss_fraction", 0.3), ("near_miss_px", (1.0, 2.0)))],
     *[(m.TruthSpec, k, CAM + "truth: {}\n", lambda s, k=k: getattr(s.truth, k), v)
       for k, v in (("albedo", True), ("lights", True), ("defocus", True), ("boxes", True))],
+    (m.TruthSpec, "objects", CAM + "objects:\n  - {name: b, shape: box, annotation: {}}\ntruth: {}\n",
+     lambda s: s.truth.objects, True),
     (m.ObjectVariation, "reseed", "objects:\n  - {name: b, shape: blob}\n"
      "variation: {objects: {b: {}}}\n", lambda s: s.variation.objects[0].reseed, True),
     (m.LightVariation, "position_jitter_m", "lights:\n  - {type: point, name: p, "
