@@ -36,7 +36,7 @@ def test_bop_toolkit_reads_the_poses_cameras_and_depth(exported):
     cams = bop.load_scene_camera(dest / SCENE / "scene_camera.json")
     assert sorted(gt) == sorted(cams) == list(range(len(ds.views))) and summary["images"] == len(ds.views)
     for im_id, view in enumerate(ds.views):
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         camera, cam_from_world = ds.camera(view)
         np.testing.assert_array_equal(cams[im_id]["cam_K"], camera.K)
         np.testing.assert_allclose(cams[im_id]["cam_R_w2c"], cam_from_world.R, atol=0)
@@ -58,7 +58,7 @@ def test_masks_and_gt_info_as_calc_gt_info_writes_them(exported):
     ds, dest, _ = exported
     infos = bop.load_json(dest / SCENE / "scene_gt_info.json", keys_to_int=True)
     for im_id, view in enumerate(ds.views):
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         ids = ds.truth(view)["object_id"]
         depth = bop.load_depth(dest / SCENE / "depth" / f"{im_id:06d}.png")
         for gt_id, o in enumerate(objs.objects):
@@ -88,7 +88,7 @@ def _touches_border(mask) -> bool:
 def test_models_and_models_info(exported):
     ds, dest, summary = exported
     info = bop.load_json(dest / "models" / "models_info.json", keys_to_int=True)
-    objs = ds.objects(ds.views[0])
+    objs = ds.object_truth(ds.views[0])
     assert sorted(info) == [m.model_id for m in objs.models] == [1, 2, 3] and summary["models"] == 3
     for m in objs.models:
         model = bop.load_ply(dest / "models" / f"obj_{m.model_id:06d}.ply")
