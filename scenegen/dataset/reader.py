@@ -281,7 +281,7 @@ class Dataset:
         return self.read(rel, lambda p: decode_boxes(read_json(p), str(p)), f"boxes of view {view!r}") \
             if self.has(rel) else None
 
-    def objects(self, view: str) -> ViewObjects | None:
+    def object_truth(self, view: str) -> ViewObjects | None:
         """The annotated objects' truth in a view (:class:`scenegen.dataset.objects.ViewObjects`:
         poses, visible fraction, full masks, keypoints, models), or None when the spec did not
         ask for it (``truth: {objects: true}``)."""

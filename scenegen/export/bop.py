@@ -59,7 +59,7 @@ def _views(ds) -> list:
     out = []
     for v in ds.views:
         try:
-            objs = ds.objects(v)
+            objs = ds.object_truth(v)
         except DatasetError as e:
             raise ExportError(str(e)) from None
         if objs is None:

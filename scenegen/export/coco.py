@@ -87,7 +87,7 @@ def export(ds, dest, progress=None) -> dict:
     images, annotations, models, roots = [], [], {}, set()
     for k, view in enumerate(ds.views):
         try:
-            objs = ds.objects(view)
+            objs = ds.object_truth(view)
         except DatasetError as e:
             raise ExportError(str(e)) from None
         if objs is None:

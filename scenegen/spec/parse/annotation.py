@@ -75,17 +75,33 @@ def _keypoint(key: Node, node: Node) -> Keypoint:
     return Keypoint(name=name, position_object_m=node.as_vec3("metres, object frame"))
 
 
+def _same_model(a, b) -> bool:
+    """Two instances declare one model alike: geometry, scale, keypoints, symmetries, skeleton."""
+    x, y = a.annotation, b.annotation
+    same_sym = len(x.symmetries_discrete) == len(y.symmetries_discrete) and all(
+        np.array_equal(p.matrix, q.matrix) for p, q in zip(x.symmetries_discrete, y.symmetries_discrete))
+    return (a.geometry == b.geometry and tuple(a.transform.scale) == tuple(b.transform.scale) and same_sym
+            and (x.keypoints, x.symmetries_continuous, x.skeleton) == (y.keypoints, y.symmetries_continuous, y.skeleton))
+
+
 def check_annotations(objects, objects_node: Node) -> None:
-    """Keypoint names unique over each annotated tree, skeleton pairs naming its keypoints."""
+    """Instances of one model declared alike; keypoint names unique over each annotated tree,
+    skeleton pairs naming its keypoints."""
     children: dict[str, list] = {}
     for o in objects:
         parent = getattr(getattr(o, "animation", None), "parent", None)
         children.setdefault(parent, []).append(o)
     nodes = objects_node.items()
+    first: dict = {}
     for i, o in enumerate(objects):
         a = o.annotation
         if a is None:
             continue
+        ref = first.setdefault(a.model, o)
+        if not _same_model(ref, o):
+            raise nodes[i].as_mapping().get("annotation").error(
+                f"model {a.model!r} is declared by {ref.name!r} with other geometry, scale, keypoints, symmetries "
+                f"or skeleton; instances of one model must be alike (a YAML anchor, `annotation: *name`, shares one)")
         names, stack = [], [o]
         while stack:  # this object and its descendants
             x = stack.pop(0)

@@ -49,7 +49,7 @@ def test_instances_masks_and_boxes(tabletop):
     assert [c["name"] for c in coco.loadCats(coco.getCatIds())] == ["crate", "can", "stone"]
     n = 0
     for image_id, view in enumerate(ds.views, start=1):
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         ids = ds.truth(view)["object_id"]
         anns = coco.loadAnns(coco.getAnnIds(imgIds=[image_id]))
         seen = [o for o in objs.objects if o.px_count_visib > 0]
@@ -73,7 +73,7 @@ def test_figure_is_one_instance_with_its_keypoints_and_skeleton(figure):
     assert ["nose", "left_shoulder"] in [[names[i - 1], names[j - 1]] for i, j in cats[0]["skeleton"]]
     flags = []
     for image_id, view in enumerate(ds.views, start=1):
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         (a,) = coco.loadAnns(coco.getAnnIds(imgIds=[image_id]))
         ids = ds.truth(view)["object_id"]
         np.testing.assert_array_equal(coco.annToMask(a).astype(bool), np.isin(ids, [o.object_id for o in objs.objects]))

@@ -90,7 +90,7 @@ def _first_hits(mesh, dirs):
 def test_ids_and_depth_equal_a_trimesh_cast_of_the_models_at_cam_from_object(ds):
     compared: dict[str, int] = {}
     for view in ds.views:
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         camera, _ = ds.camera(view)
         truth = ds.truth(view)
         mesh, face_ids = _scene_cam(ds, view, objs)
@@ -121,7 +121,7 @@ def test_ids_and_depth_equal_a_trimesh_cast_of_the_models_at_cam_from_object(ds)
 
 def test_full_masks_and_visible_fraction_equal_an_independent_cast_alone(ds):
     for view in ds.views:
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         camera, _ = ds.camera(view)
         W, H = camera.width, camera.height
         ids = ds.truth(view)["object_id"]
@@ -138,14 +138,14 @@ def test_full_masks_and_visible_fraction_equal_an_independent_cast_alone(ds):
             assert o.px_count_visib == n_vis
             assert o.visib_fract == pytest.approx(n_vis / hit.sum(), abs=EDGE_PIXELS / hit.sum())
             assert not (objs.mask_full[k] < (ids == o.object_id)).any()  # visible within full
-    fracts = [o.visib_fract for v in ds.views for o in ds.objects(v).objects]
+    fracts = [o.visib_fract for v in ds.views for o in ds.object_truth(v).objects]
     assert min(fracts) < 0.9 and max(fracts) == 1.0  # some occlusion, some not: the scene tests both
 
 
 def test_keypoints_equal_cv2_project_points_and_their_states_an_independent_cast(ds):
     states = []
     for view in ds.views:
-        objs = ds.objects(view)
+        objs = ds.object_truth(view)
         camera, _ = ds.camera(view)
         mesh, face_ids = _scene_cam(ds, view, objs)
         caster = RayMeshIntersector(mesh)
@@ -173,7 +173,7 @@ def test_keypoints_equal_cv2_project_points_and_their_states_an_independent_cast
 
 def test_vertex_keypoints_and_models(objects_dataset):
     ds = Dataset(objects_dataset)
-    objs = ds.objects(ds.views[0])
+    objs = ds.object_truth(ds.views[0])
     can = objs.by_name("can")
     side = [k for k in can.keypoints if k.name == "side"][0]
     np.testing.assert_allclose(side.position_object_m, _model(ds, can).vertices[3], atol=1e-7)  # float32 PLY
@@ -212,7 +212,7 @@ def test_joint_values_equal_the_spec_keyframes_at_keyframe_times(figure_dataset)
     ds = Dataset(figure_dataset)
     expected = {"upper_arm_l": (0, 100), "forearm_l": (10, 60), "upper_arm_r": (-10, -30), "forearm_r": (20, 70),
                 "thigh_l": (0, 35), "shin_l": (0, -50)}
-    first, last = ds.objects(ds.views[0]), ds.objects(ds.views[2])
+    first, last = ds.object_truth(ds.views[0]), ds.object_truth(ds.views[2])
     for name, (a0, a1) in expected.items():
         for objs, deg in ((first, a0), (last, a1)):
             j = objs.by_name(name).joint

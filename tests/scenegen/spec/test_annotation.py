@@ -105,3 +105,20 @@ def test_bad_annotations_are_one_line_errors_naming_the_line(line, message):
 def test_object_truth_without_annotated_objects_is_refused():
     with pytest.raises(SpecError, match="no object has one"):
         parse_spec(HEAD + "truth: {objects: true}\nobjects: [{name: b, shape: box}]\n", file="s.yaml")
+
+
+def test_instances_of_one_model_must_be_alike():
+    text = HEAD + """objects:
+  - {name: a, shape: {type: box, size: [0.1, 0.1, 0.1]}, annotation: {model: m, keypoints: {k: [0, 0, 0.05]}}}
+  - {name: b, shape: {type: box, size: [0.1, 0.1, 0.1]}, annotation: {model: m, keypoints: {k: [0, 0, 0.05]}}}
+"""
+    assert parse_spec(text).objects[1].annotation.model == "m"
+    for other in ("size: [0.1, 0.1, 0.2]", "keypoints: {k: [0, 0, 0.04]}"):
+        lines = text.splitlines()
+        if other.startswith("size"):
+            lines[-1] = lines[-1].replace("size: [0.1, 0.1, 0.1]", other)
+        else:
+            lines[-1] = lines[-1].replace("keypoints: {k: [0, 0, 0.05]}", other)
+        with pytest.raises(SpecError, match="instances of one model must be alike") as e:
+            parse_spec("\n".join(lines) + "\n", file="s.yaml")
+        assert str(e.value).startswith("s.yaml:6: objects[1].annotation"), str(e.value)  # the second instance
