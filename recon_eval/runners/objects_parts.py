@@ -71,14 +71,14 @@ def part_errors(bop, rows, parents: dict, joints: dict | None = None) -> dict:
 def tree(ds) -> tuple[dict, dict]:
     """(child model id -> parent model id, (0, im_id) -> child model id -> joint truth) from the
     dataset's object truth; BOP's im_id is the view's position (scenegen's BOP export)."""
-    objs = ds.objects(ds.views[0]) if hasattr(ds, "objects") else None
+    objs = ds.object_truth(ds.views[0])
     if objs is None:
         raise NotApplicable(f"{ds.root}: no object truth (truth: {{objects: true}}): the part tree is unknown")
     by_name = {o.name: o for o in objs.objects}
     parents = {o.model_id: by_name[o.parent].model_id for o in objs.objects if o.parent in by_name}
     joints = {}
     for im_id, view in enumerate(ds.views):
-        v = ds.objects(view)
+        v = ds.object_truth(view)
         joints[(0, im_id)] = {o.model_id: o.joint for o in (v.objects if v else ()) if o.joint is not None}
     return parents, joints
 
