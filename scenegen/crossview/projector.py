@@ -18,7 +18,6 @@ import numpy as np
 from scenegen.dataset.structured_light import ProjectorTruth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
-from scenegen.imaging.projector_sequences import gray_code
 
 
 def projector_pixels(points_world, projector: Camera, projector_from_world: Rigid3) -> np.ndarray:
@@ -57,5 +56,5 @@ def projector_truth(points_world, normals_world, camera_center_world, projector:
         lit = flat.reshape(H, W)
     column = np.where(lit, col, -1).astype(np.int32)
     row_i = np.where(lit, row, -1).astype(np.int32)
-    gray = lambda a: np.where(a >= 0, gray_code(np.maximum(a, 0)), -1).astype(np.int32)
+    gray = lambda a: np.where(a >= 0, a ^ (np.maximum(a, 0) >> 1), -1).astype(np.int32)  # reflected binary
     return ProjectorTruth(uv=uv, lit=lit, column=column, row=row_i, gray_column=gray(column), gray_row=gray(row_i))

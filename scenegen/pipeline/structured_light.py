@@ -80,10 +80,12 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
         else:  # the chain's temporal noise drawn anew for each pattern
             image = apply_chain(linear, params, cam, hashed_seed32(frame_seed(spec.seed, index), k)).image
         files[pattern_image_path(view.name, k)] = encode_png(image)
-        files[pattern_linear_path(view.name, k)] = encode_exr(pack_channels("", linear.astype(np.float32),
-                                                                            LINEAR_CHANNELS))
-        entries.append({"index": k, "name": pat.name, "axis": pat.axis, "bit": pat.bit, "inverse": pat.inverse,
-                        "image": pattern_image_path(view.name, k), "linear": pattern_linear_path(view.name, k)})
+        entry = {"index": k, "name": pat.name, "axis": pat.axis, "bit": pat.bit, "inverse": pat.inverse,
+                 "image": pattern_image_path(view.name, k)}
+        if lit.spec.linear_patterns:
+            entry["linear"] = pattern_linear_path(view.name, k)
+            files[entry["linear"]] = encode_exr(pack_channels("", linear.astype(np.float32), LINEAR_CHANNELS))
+        entries.append(entry)
     p = lit.spec
     world_from_cam = view.cam_from_world.inverse()
     doc = {"format": PATTERNS_FORMAT, "view": view.name,

@@ -52,6 +52,7 @@ class ProjectorSpec:
     pattern_axes: str = param("both", unit="coded axes", choices=AXES)
     pattern_inverse: bool = param(True, unit="flag")  # each bit pattern followed by its inverse
     pattern_white_black: bool = param(True, unit="flag")  # an all-white and an all-black pattern first
+    linear_patterns: bool = param(False, unit="flag")  # also write each pattern's clean linear EXR
     where: Where | None = where_field()
 
     @property
