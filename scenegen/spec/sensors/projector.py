@@ -83,7 +83,7 @@ def parse_projector(node, name, ctx) -> ProjectorSpec:
     inode = f.get(_INTRINSICS)
     cam = parse_camera(inode, name, ctx)
     if cam.optics is not None or cam.imaging is not None:
-        bad = next(k for k in inode.as_mapping() if k not in _CAMERA_KEYS)
+        bad = next(k for k in inode.as_mapping().keys() if k not in _CAMERA_KEYS)
         raise inode.as_mapping().get(bad).error("a projector's intrinsics take the camera model keys only "
                                                 f"({', '.join(_CAMERA_KEYS)}); got {bad!r}")
     return ProjectorSpec(name=name, intrinsics=cam, where=node.where, **read_fields(f, ProjectorSpec))
