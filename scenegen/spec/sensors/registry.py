@@ -6,11 +6,13 @@ from __future__ import annotations
 from scenegen.spec.sensors.camera import CAMERA
 from scenegen.spec.sensors.imu import IMU
 from scenegen.spec.sensors.kind import SensorKind
+from scenegen.spec.sensors.projector import PROJECTOR
 
 #: Sensor kind name -> SensorKind (a rig member's default kind: RigMember.kind, the camera).
 SENSOR_KINDS: dict[str, SensorKind] = {
     CAMERA.name: CAMERA,
     IMU.name: IMU,
+    PROJECTOR.name: PROJECTOR,
 }
 
 

@@ -1,0 +1,61 @@
+"""A projector-lit view's per-pixel truth (:class:`scenegen.dataset.structured_light.ProjectorTruth`)
+from the view's stored truth points, in numpy: the projector as an inverse camera.
+
+The projector pixel of a camera pixel is the projection of the view's stored ``points_world``
+(float32, taken exactly, computed in float64) through the projector's model
+(:meth:`scenegen.geometry.camera.Camera.project`, distortion and skew included).
+The pixel a perfect decoder reads is the one whose square covers it: column ``floor(u + 0.5)``,
+row ``floor(v + 0.5)`` (OpenCV centres, :mod:`scenegen.geometry.conventions`), the same rule as
+the renderer's pattern lookup (:mod:`scenegen.render.projector`). A point is lit when that pixel
+lies in the projector's image, the side of the surface the camera sees faces the projector
+centre, and the visibility cast from the projector centre reaches the point (a separate ray cast:
+projector shadows).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scenegen.dataset.structured_light import ProjectorTruth
+from scenegen.geometry.camera import Camera
+from scenegen.geometry.pose import Rigid3
+from scenegen.imaging.projector_sequences import gray_code
+
+
+def projector_pixels(points_world, projector: Camera, projector_from_world: Rigid3) -> np.ndarray:
+    """(..., 2) float64 projector pixels of world points (..., 3); NaN where invalid."""
+    P = np.asarray(points_world, np.float64)
+    flat = P.reshape(-1, 3)
+    uv = np.full((len(flat), 2), np.nan)
+    ok = np.isfinite(flat).all(axis=1)
+    if ok.any():
+        uv[ok] = projector.project(projector_from_world.apply(flat[ok]))
+    return uv.reshape(P.shape[:-1] + (2,))
+
+
+def projector_truth(points_world, normals_world, camera_center_world, projector: Camera,
+                    projector_from_world: Rigid3, visible) -> ProjectorTruth:
+    """The truth of one view (module docstring). ``points_world``, ``normals_world``: (H, W, 3)
+    as stored (NaN = no surface); ``visible(center (3,), points (N, 3)) -> (N,) bool``: the
+    visibility cast of the scene at the view's time."""
+    P = np.asarray(points_world, np.float64)
+    N = np.asarray(normals_world, np.float64)
+    H, W = P.shape[:2]
+    uv = projector_pixels(P, projector, projector_from_world)
+    center = projector_from_world.inverse().t
+    with np.errstate(invalid="ignore"):
+        col = np.floor(uv[..., 0] + 0.5)
+        row = np.floor(uv[..., 1] + 0.5)
+        inside = (col >= 0) & (col < projector.width) & (row >= 0) & (row < projector.height)
+        facing_cam = np.sign(np.einsum("hwk,hwk->hw", N, np.asarray(camera_center_world, np.float64) - P))
+        facing_proj = np.einsum("hwk,hwk->hw", N, center - P) * facing_cam > 0
+    lit = inside & facing_proj
+    idx = np.flatnonzero(lit.ravel())
+    if len(idx):
+        seen = visible(center, P.reshape(-1, 3)[idx])
+        flat = lit.ravel()
+        flat[idx] = np.asarray(seen, bool)
+        lit = flat.reshape(H, W)
+    column = np.where(lit, col, -1).astype(np.int32)
+    row_i = np.where(lit, row, -1).astype(np.int32)
+    gray = lambda a: np.where(a >= 0, gray_code(np.maximum(a, 0)), -1).astype(np.int32)
+    return ProjectorTruth(uv=uv, lit=lit, column=column, row=row_i, gray_column=gray(column), gray_row=gray(row_i))
