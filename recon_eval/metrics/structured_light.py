@@ -32,6 +32,7 @@ class CodeResult:
     n_decoded: int  # of those, decoded
     completeness: float  # n_decoded / n_lit
     agreement: float  # lit pixels decoded to the truth projector pixel / n_lit
+    agreement_decoded: float  # the same over the decoded lit pixels (n_decoded)
     mean_px: float  # code error over decoded lit pixels
     rms_px: float
     median_px: float
@@ -66,7 +67,9 @@ def code_errors(decoded_px, truth_code, lit, *, lengths_px, truth_px=None) -> Co
     err = np.linalg.norm(dec[scored] - ref[scored], axis=1)
     n_lit, n_dec = int(lit.sum()), int(scored.sum())
     n_all = int(decoded.sum())
-    return CodeResult(n_lit, n_dec, n_dec / n_lit if n_lit else math.nan, int(agree.sum()) / n_lit if n_lit else math.nan,
+    n_agree = int(agree.sum())
+    return CodeResult(n_lit, n_dec, n_dec / n_lit if n_lit else math.nan, n_agree / n_lit if n_lit else math.nan,
+                      n_agree / n_dec if n_dec else math.nan,
                       *_stats(err), int((decoded & ~lit).sum()) / n_all if n_all else math.nan,
                       "codes" if truth_px is None else "coordinates")
 

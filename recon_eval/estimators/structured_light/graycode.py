@@ -31,8 +31,9 @@ class DecodedAxis:
 def decode_axis(patterns, inverses, *, length_px: int, threshold: float, gray: bool = True,
                 mask=None) -> DecodedAxis:
     """Decode one axis from (n_bits, H, W) pattern images and their (n_bits, H, W) inverses
-    (linear or encoded grey values, most significant bit first). ``mask`` (H, W) bool: pixels to
-    decode (e.g. white - black above a contrast); None: all."""
+    (linear or encoded grey values, most significant bit first). ``threshold``: a scalar or (H, W)
+    per pixel (e.g. a fraction of the pixel's white - black contrast). ``mask`` (H, W) bool: pixels
+    to decode (e.g. white - black above a contrast); None: all."""
     p = np.asarray(patterns, dtype=np.float64)
     q = np.asarray(inverses, dtype=np.float64)
     if p.ndim != 3 or p.shape != q.shape or p.shape[0] < 1:
