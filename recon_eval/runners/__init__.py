@@ -147,6 +147,9 @@ METHODS: dict[str, Method] = {m.name: m for m in [
        "projector-camera calibration (Moreno and Taubin 2012): Gray codes decoded, local homographies (29 x 29 px) "
        "carry the board corners into the projector, cv2.calibrateCamera for each, cv2.stereoCalibrate",
        half_window_px=14, threshold=0.1, min_contrast=0.005),
+    _m("sl-turntable-gray", "turntable", "run",
+       "turntable scan: sl-gray-code per step, the clouds registered with the known turntable motion, merged, "
+       "cropped to the object's box + 2 mm", threshold=0.1, min_contrast=0.005, tau_m=0.001, crop_margin_m=0.002),
     _m("ikeuchi-horn-sfs", "shading", "run",
        "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
        "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),

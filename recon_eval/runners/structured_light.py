@@ -150,7 +150,7 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
     cat = {k: np.concatenate(v)[:, None] for k, v in pooled.items()}  # (N, 1[, 2]): one image column
     axes = [a for a in (0, 1) if np.isfinite(cat["dec"][..., a]).any()] or [0]
     lengths = [(views[0].projector.width, views[0].projector.height)[a] for a in axes]
-    results["all.codes"] = code_errors(cat["dec"][..., axes], cat["code"][..., axes], cat["lit"][..., 0],
+    results["all.codes"] = code_errors(cat["dec"][..., axes], cat["code"][..., axes], cat["lit"],
                                        lengths_px=lengths)
     results["all.depth"] = depth_errors(cat["depth"], cat["gt"], cat["lit"], bound_m=cat["bound"])
     c, d = results["all.codes"], results["all.depth"]
