@@ -39,6 +39,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("tracks", "point tracks over a sequence: TAP-Vid AJ, < delta_avg, OA against the truth tracks", "tracks"),
     Command("normals", "normal maps (photometric stereo): DiLiGenT mean/median angular error, < 10/20/30 deg; "
                        "albedo up to scale; light directions", "photometric"),
+    Command("codes", "structured light code maps: agreement with the truth codes over lit pixels, completeness, "
+                     "code error in projector pixels; the decoder's cloud", "structured_light"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
     Command("sweep", "F, H, E, PnP or triangulation estimators over noise and outliers on exact truth: per-cell "
                      "error statistics, breakdown points", "sweep",
