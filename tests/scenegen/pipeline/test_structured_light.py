@@ -67,7 +67,7 @@ def projector_of(seq) -> tuple[Camera, Rigid3]:
 def test_the_run_verifies_and_holds_the_sequence(rendered):
     d, view, seq, t = rendered
     assert verify(d.root).ok
-    assert [e["name"] for e in seq["patterns"]][:4] == ["white", "black", "col_bit05", "col_bit05_inv"]
+    assert [e["name"] for e in seq["patterns"]][:4] == ["white", "black", "u_bit05", "u_bit05_inv"]
     assert d.pattern_images(view).shape == (14, 36, 48, 3)
     assert np.array_equal(d.pattern_images(view)[0], d.image(view))  # the view's image is pattern 0's
     assert 0.3 < t.lit.mean() < 1.0  # the box casts a projector shadow

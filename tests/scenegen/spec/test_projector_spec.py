@@ -8,7 +8,7 @@ import pytest
 
 from scenegen import cli
 from scenegen.errors import SpecError
-from scenegen.imaging.projector_sequences import gray_sequence
+from scenegen.imaging.projector_sequences import SEQUENCES, SequenceOptions, frame_entry
 from scenegen.spec import parse_spec, same_spec, spec_sha256, spec_to_dict, to_yaml
 from scenegen.spec.sensors import LIGHT, SENSOR_KINDS
 from scenegen.spec.views import resolve_views
@@ -55,9 +55,9 @@ def test_a_projector_is_read_with_its_camera_model_radiometry_and_sequence(tmp_p
     # the rig's views are its camera's: the projector lights them
     assert [v.name for v in resolve_views(spec)] == ["r_cam_0000"]
     # white, black, 5 column bits and 4 row bits, each with its inverse
-    pats = p.pattern_images()
-    assert len(pats) == 2 + 2 * (5 + 4) and pats[0].name == "white" and pats[3].inverse
-    assert all(a.values.shape == (10, 20) for a in pats)
+    seq = p.pattern_sequence()
+    assert len(seq.frames) == 2 + 2 * (5 + 4) and seq.frames[0].kind == "white" and seq.frames[3].inverse
+    assert seq.images.shape == (20, 10, 20)
 
 
 def test_the_response_is_black_level_plus_the_gamma_curve(tmp_path):
@@ -67,13 +67,20 @@ def test_the_response_is_black_level_plus_the_gamma_curve(tmp_path):
     assert np.allclose(spec_p.relative_output(values), expected, rtol=0, atol=1e-15)
 
 
-def test_the_gray_sequence_codes_every_column_with_its_gray_code():
-    pats = gray_sequence(20, 10, axes="columns", inverse=True, white_black=False)
-    bits = [p for p in pats if not p.inverse]
-    code = sum((p.values[0].astype(int) << p.bit) for p in bits)
+def test_the_sequence_file_entries_name_each_bit_from_the_least_significant():
+    seq = SEQUENCES["gray"](20, 10, SequenceOptions(axes="columns", references=False))
+    entries = [frame_entry(f) for f in seq.frames]
+    assert [e["name"] for e in entries[:3]] == ["u_bit04", "u_bit04_inv", "u_bit03"]
+    code = sum((img[0].astype(int) << e["bit"]) for e, img in zip(entries, seq.images) if not e["inverse"])
     cols = np.arange(20)
-    assert np.array_equal(code, cols ^ (cols >> 1))
-    assert all(np.array_equal(a.values, 1 - b.values) for a, b in zip(pats[::2], pats[1::2]))
+    assert np.array_equal(code, cols ^ (cols >> 1))  # the reflected binary code of every column
+    assert all(e["axis"] == "columns" and e["n_bits"] == 5 for e in entries)
+
+
+def test_a_phase_sequence_coarser_than_the_projector_is_refused(tmp_path):
+    text = PROCAM.replace("falloff: cos4", "falloff: cos4\n    patterns: phase_shift\n    phase_periods_px: [8, 2]")
+    with pytest.raises(SpecError, match="scene.yaml:15: .*the coarsest period 8.0 px is shorter than the u axis"):
+        parse(text, tmp_path)
 
 
 def test_the_projector_round_trips_with_its_values(tmp_path):
