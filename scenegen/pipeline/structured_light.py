@@ -56,13 +56,14 @@ def lit_view(spec, view) -> LitView | None:
     return LitView(member, p, projector_from_world, p.pattern_sequence())
 
 
-def render_patterns(built, view, lit: LitView, *, spp: int, seed: int, time_s) -> list[np.ndarray]:
-    """Linear float32 (H, W, 3) renders of the view under each pattern; pattern k's sampler seed
-    is hashed from the view's seed and k."""
+def render_patterns(built, view, lit: LitView, *, spp: int, seed: int, time_s, count: int | None = None
+                    ) -> list[np.ndarray]:
+    """Linear float32 (H, W, 3) renders of the view under each pattern (the first ``count``;
+    None: all); pattern k's sampler seed is hashed from the view's seed and k."""
     return [built.render_pattern(view.camera, view.cam_from_world, lit.member.sensor, lit.projector_from_world,
                                  values, spp=spp, seed=hashed_seed32(seed, k), motion=view.motion,
                                  light_scales=view.light_scales, time_s=time_s)
-            for k, values in enumerate(lit.sequence.images)]
+            for k, values in enumerate(lit.sequence.images[:count])]
 
 
 def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, truth, visible) -> dict[str, bytes]:
