@@ -97,7 +97,10 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
                          "falloff": p.falloff, "sequence": p.patterns},
            "patterns": entries}
     files[pattern_sequence_path(view.name)] = encode_json(doc)
+    u, v = np.meshgrid(np.arange(cam.width + 1) - 0.5, np.arange(cam.height + 1) - 0.5)
+    corners = built.surface_points(cam, view.cam_from_world, np.stack([u.ravel(), v.ravel()], axis=1),
+                                   time_s=getattr(view, "time_s", None)).reshape(cam.height + 1, cam.width + 1, 3)
     t = projector_truth(truth[TruthKind.POINTS_WORLD], truth[TruthKind.NORMALS_WORLD], world_from_cam.t,
-                        p.to_camera(), lit.projector_from_world, visible)
+                        p.to_camera(), lit.projector_from_world, visible, corners)
     files[projector_truth_path(view.name)] = encode_projector_truth(t)
     return files
