@@ -17,6 +17,7 @@ BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.
            "bench_dask_window.py",
            "bench_lidar.py",
            "bench_tof.py",
+           "bench_structured_light.py",
            )
 
 

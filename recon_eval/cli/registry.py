@@ -43,6 +43,8 @@ COMMANDS: tuple[Command, ...] = (
                        "albedo up to scale; light directions", "photometric"),
     Command("objects", "6D object poses (BOP19 CSV) and keypoints (COCO results): BOP19 AR (VSD, MSSD, MSPD), "
                        "ADD/ADD-S recall, COCO keypoint AP, PCK", "objects"),
+    Command("codes", "structured light code maps: agreement with the truth codes over lit pixels, completeness, "
+                     "code error in projector pixels; the decoder's cloud", "structured_light"),
     Command("fmatrix", "fundamental matrix: Sampson, symmetric epipolar, Zhang distance, pose via K", "twoview"),
     Command("sweep", "F, H, E, PnP or triangulation estimators over noise and outliers on exact truth: per-cell "
                      "error statistics, breakdown points", "sweep",

@@ -60,6 +60,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
          ("dlt", None): "DLT camera matrices", ("triangulate", None): "triangulation",
          ("photometric", None): "photometric stereo", ("near_light", None): "photometric stereo", ("focus", "sml"): "depth from focus", ("focus", "stm"): "depth from defocus",
+         ("structured_light", None): "structured light", ("procam", None): "projector-camera calibration",
+         ("turntable", None): "turntable scan",
          ("shading", None): "shape from shading", ("zoom", None): "depth from zooming", ("texture", None): "shape from texture", ("flow", "dense"): "optical flow", ("flow", "lk"): "feature tracks", ("tracking", None): "point tracks (TAP-Vid)",
          ("faults", "calib_cx"): "calibration", ("faults", "f_transposed"): "fundamental matrix",
          ("external", "fmatrix"): "fundamental matrix", ("fsurvey", None): "fundamental matrix",
@@ -133,6 +135,23 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("stm-dfd", "focus", "stm",
        "depth from defocus, two images: Subbarao and Surya's spatial-domain transform (Gaussian window 4 px), "
        "thin-lens blur to depth in closed form", window_px=4.0),
+    _m("sl-gray-code", "structured_light", "gray",
+       "Gray-code decoder: each bit from the pattern against its inverse (unreliable below 0.1 of the pixel's "
+       "white - black contrast), Gray to binary, camera ray against the decoded projector column", threshold=0.1,
+       min_contrast=0.005, triangulation="plane", tau_m=0.001),
+    _m("sl-gray-code-rays", "structured_light", "gray",
+       "Gray-code decoder as sl-gray-code, midpoint of the camera ray and the projector ray of (column, row)",
+       threshold=0.1, min_contrast=0.005, triangulation="rays", tau_m=0.001),
+    _m("sl-phase-shift", "structured_light", "phase",
+       "N-step phase shifting with hierarchical temporal unwrapping, camera ray against the continuous column",
+       min_modulation=0.005, tau_m=0.001),
+    _m("sl-procam-calib", "procam", "run",
+       "projector-camera calibration (Moreno and Taubin 2012): Gray codes decoded, local homographies (29 x 29 px) "
+       "carry the board corners into the projector, cv2.calibrateCamera for each, cv2.stereoCalibrate",
+       half_window_px=14, threshold=0.1, min_contrast=0.005),
+    _m("sl-turntable-gray", "turntable", "run",
+       "turntable scan: sl-gray-code per step, the clouds registered with the known turntable motion, merged, "
+       "cropped to the object's box + 2 mm", threshold=0.1, min_contrast=0.005, tau_m=0.001, crop_margin_m=0.002),
     _m("ikeuchi-horn-sfs", "shading", "run",
        "shape from shading: Ikeuchi-Horn iterations from the occluding boundary, Frankot-Chellappa "
        "integrability each iteration (200 iterations, step 8), light and albedo known", iterations=200, step=8.0),

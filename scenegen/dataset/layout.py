@@ -20,6 +20,10 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_boxes.json                 2D and 3D bounding boxes per object (truth.boxes)
     truth/<view>_objects.json               annotated objects: poses, visible fraction, keypoints (truth.objects)
     truth/<view>_objects.npz                their full (amodal) masks, packed bits (truth.objects)
+    truth/<view>_projector.npz              a projector-lit view: projector pixel, lit mask, codes per pixel
+    patterns/<view>/sequence.json           a projector-lit view: the projector, its pose and the patterns
+    patterns/<view>/<k>.png                 the view under pattern k (k = 000, 001, ...; encoded as images/)
+    patterns/<view>/<k>_linear.exr          ... its clean linear float32 RGB (projector linear_patterns)
     raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
     images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote
@@ -57,7 +61,7 @@ MAX_NAME_LEN = 128
 #: A view name may not end like another view's suffixed files (view "a_ids" would clash with
 #: view "a"'s truth/a_ids.exr).
 RESERVED_VIEW_SUFFIXES = ("_linear", "_ids", "_valid", "_vignetting", "_raw", "_albedo", "_lights", "_coc",
-                          "_boxes", "_objects")
+                          "_boxes", "_objects", "_projector")
 MATCH_KINDS = ("synthetic", "sift")
 
 CROSSVIEW = "crossview"
@@ -197,6 +201,36 @@ def object_masks_path(view: str) -> str:
 #: The raw mosaic of a view of a camera with ``imaging.raw`` (templates recorded in cameras.json).
 RAW_DNG_TEMPLATE = "raw/{view}.dng"
 RAW_PNG_TEMPLATE = "images/{view}_raw.png"
+
+
+PATTERNS_DIR = "patterns"
+
+
+def projector_truth_path(view: str) -> str:
+    """``truth/<view>_projector.npz``: a projector-lit view's per-pixel projector truth
+    (:mod:`scenegen.dataset.structured_light`)."""
+    return f"truth/{check_view_name(view)}_projector.npz"
+
+
+def pattern_sequence_path(view: str) -> str:
+    """``patterns/<view>/sequence.json``: the projector, its pose and the patterns of a view."""
+    return f"{PATTERNS_DIR}/{check_view_name(view)}/sequence.json"
+
+
+def pattern_image_path(view: str, k: int) -> str:
+    """``patterns/<view>/<k>.png``: the view under pattern ``k`` (three digits)."""
+    return f"{PATTERNS_DIR}/{check_view_name(view)}/{_pattern_index(k)}.png"
+
+
+def pattern_linear_path(view: str, k: int) -> str:
+    """``patterns/<view>/<k>_linear.exr``: the clean linear render under pattern ``k``."""
+    return f"{PATTERNS_DIR}/{check_view_name(view)}/{_pattern_index(k)}_linear.exr"
+
+
+def _pattern_index(k: int) -> str:
+    if isinstance(k, bool) or int(k) != k or not 0 <= int(k) < 1000:
+        raise ValueError(f"pattern index must be an integer in [0, 999], got {k!r}")
+    return f"{int(k):03d}"
 
 
 def raw_dng_path(view: str) -> str:

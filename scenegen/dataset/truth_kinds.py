@@ -76,3 +76,47 @@ TRUTH_ID_KEYS: tuple[TruthKind, ...] = tuple(k for k, i in TRUTH_KIND_INFO.items
 TRUTH_KEYS: tuple[TruthKind, ...] = tuple(TRUTH_KIND_INFO)
 #: Kinds that are +inf (not NaN) on misses.
 TRUTH_DISTANCE_KEYS = (TruthKind.DEPTH_Z, TruthKind.RANGE)
+
+
+class ProjectorTruthKind(str, Enum):
+    """The per-pixel truth of a camera view lit by a projector (structured light), stored apart
+    from the camera's own truth in ``truth/<view>_projector.npz`` (docs/dataset_format.md,
+    "Structured light"): the projector pixel each camera pixel's truth point projects to, whether
+    the projector lights it, and the codes a perfect decoder reads there."""
+
+    PROJECTOR_UV = "projector_uv"
+    PROJECTOR_LIT = "projector_lit"
+    PROJECTOR_COLUMN = "projector_column"
+    PROJECTOR_ROW = "projector_row"
+    GRAY_COLUMN = "gray_column"
+    GRAY_ROW = "gray_row"
+    CLEAR_COLUMN = "clear_column"
+    CLEAR_ROW = "clear_row"
+
+    __str__ = str.__str__
+    __format__ = str.__format__
+
+
+#: Each projector truth kind's storage (``components``: the last axis's meaning; ``file``: the
+#: npz member is the kind's name).
+PROJECTOR_TRUTH_INFO: dict[ProjectorTruthKind, TruthKindInfo] = {
+    ProjectorTruthKind.PROJECTOR_UV: TruthKindInfo(
+        np.float64, ("u", "v"), None, "projector pixels, OpenCV centres, of the stored points_world (float64)",
+        "projector", np.nan),
+    ProjectorTruthKind.PROJECTOR_LIT: TruthKindInfo(
+        np.bool_, None, None, "bool: inside the projector image, facing it, nothing between", "projector", False),
+    ProjectorTruthKind.PROJECTOR_COLUMN: TruthKindInfo(
+        np.int32, None, None, "projector column index floor(u + 0.5) where lit", "projector", -1),
+    ProjectorTruthKind.PROJECTOR_ROW: TruthKindInfo(
+        np.int32, None, None, "projector row index floor(v + 0.5) where lit", "projector", -1),
+    ProjectorTruthKind.GRAY_COLUMN: TruthKindInfo(
+        np.int32, None, None, "Gray code of the column: c ^ (c >> 1), where lit", "projector", -1),
+    ProjectorTruthKind.GRAY_ROW: TruthKindInfo(
+        np.int32, None, None, "Gray code of the row: r ^ (r >> 1), where lit", "projector", -1),
+    ProjectorTruthKind.CLEAR_COLUMN: TruthKindInfo(
+        np.bool_, None, None, "bool: lit, and the pixel's four corners see lit points of the same projector column",
+        "projector", False),
+    ProjectorTruthKind.CLEAR_ROW: TruthKindInfo(
+        np.bool_, None, None, "bool: lit, and the pixel's four corners see lit points of the same projector row",
+        "projector", False),
+}

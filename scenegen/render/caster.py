@@ -17,7 +17,7 @@ import mitsuba as mi
 import numpy as np
 
 from scenegen.geometry.pose import Rigid3
-from scenegen.render import raycast
+from scenegen.render import projector, raycast
 from scenegen.render.albedo import albedo_pass
 from scenegen.render.alone import alone_distances
 from scenegen.render.beams import cast_at_times
@@ -41,9 +41,24 @@ class Caster:
 
     def render(self, camera_name: str, cam_from_world: Rigid3, *, spp: int, seed: int, motion=None,
                light_scales=None, time_s: float | None = None) -> np.ndarray:
-        """Linear float32 (H, W, 3) of a view (:func:`scenegen.render.frames.render_view`)."""
+        """Linear float32 (H, W, 3) of a view (:func:`scenegen.render.frames.render_view`), every
+        projector off."""
+        projector.all_off(self.device)
         return render_view(self.device, camera_name, cam_from_world, spp=spp, seed=seed, motion=motion,
                            light_scales=light_scales, time_s=time_s)
+
+    def render_pattern(self, camera_name: str, cam_from_world: Rigid3, projector_name: str,
+                       projector_from_world: Rigid3, pattern_values, *, spp: int, seed: int, motion=None,
+                       light_scales=None, time_s: float | None = None) -> np.ndarray:
+        """Linear float32 (H, W, 3) of a view lit by one projector showing ``pattern_values``
+        (its (H_p, W_p[, 3]) image in [0, 1], :func:`scenegen.render.projector.show`) on top of
+        the scene's lights at ``light_scales``."""
+        projector.show(self.device, projector_name, projector_from_world, pattern_values)
+        try:
+            return render_view(self.device, camera_name, cam_from_world, spp=spp, seed=seed, motion=motion,
+                               light_scales=light_scales, time_s=time_s)
+        finally:
+            projector.all_off(self.device)
 
     def render_ideal(self, sensor_camera_name: str, camera, cam_from_world: Rigid3, *, spp: int, seed: int,
                      light_scales=None, time_s: float | None = None) -> np.ndarray:

@@ -75,6 +75,7 @@ class SceneDescription:
     sampler: str  # the sensors' Mitsuba sampler plugin (it rounds spp up: effective_spp)
     max_depth: int
     spec_sha256: str = field(repr=False)
+    projectors: dict = field(default_factory=dict)  # projector name -> scenegen.spec.sensors.projector.ProjectorSpec
 
     @cached_property
     def content_hash(self) -> str:
@@ -178,4 +179,5 @@ def describe(spec: m.SceneSpec, *, spp: int, sampler: str, max_depth: int) -> Sc
         timeline=timeline,
         rest_time_s=float(sequence.timestamps_s[0]) if animated else None,
         motion_subframes=spec.render.motion_subframes if moving else 1,
-        spp=int(spp), sampler=sampler, max_depth=int(max_depth), spec_sha256=spec_sha256(spec))
+        spp=int(spp), sampler=sampler, max_depth=int(max_depth), spec_sha256=spec_sha256(spec),
+        projectors=dict(spec.sensors.get("projector", {})))

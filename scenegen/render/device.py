@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import mitsuba as mi
 
+from scenegen.render import projector as projector_mod
 from scenegen.render import sensor as sensor_mod
 from scenegen.render.animate import Animated, animated_entry, place_animated
 from scenegen.render.description import SceneDescription
@@ -47,6 +48,7 @@ class DeviceScene:
     timed_scenes: TimedScenes | None = field(default=None, repr=False)  # made on first use (:meth:`timed`)
     alone_scenes: dict = field(default_factory=dict, repr=False)  # object id -> (its scene alone,
     # world_from_ref), made on first use (:mod:`scenegen.render.alone`)
+    projectors: dict = field(default_factory=dict)  # projector name -> ProjectorEmitter (off until shown)
 
     # read-only views of the description, for the modules that render (frames, lights, animate)
     @property
@@ -117,17 +119,24 @@ def build_device(desc: SceneDescription) -> DeviceScene:
             instance_ids[key] = obj.instance_id
     for i, light in enumerate(desc.lights):
         d[light_key(i)] = light_entry(light)
+    if desc.projectors:
+        projector_mod.register()
+    for name in desc.projectors:
+        d[projector_mod.projector_key(name)] = projector_mod.projector_entry(name)
     for name, cam in desc.cameras.items():
         shutter = getattr(desc.optics[name], "shutter", None)
         timed = shutter is not None and (shutter.exposure_s > 0 or shutter.rolling_readout_s > 0)
         d[f"sensor_{name}"] = sensor_mod.sensor_dict(cam, spp=desc.spp, sampler=desc.sampler, name=name, timed=timed)
     # what the timed casts' still scene shares (the Mitsuba shapes themselves), no sensors
-    entries = {k: v for k, v in d.items() if k not in ("type", "integrator") and not k.startswith("sensor_")}
+    entries = {k: v for k, v in d.items() if k not in ("type", "integrator") and not k.startswith("sensor_")
+               and k not in {projector_mod.projector_key(n) for n in desc.projectors}}
     scene = mi.load_dict(d)
     device = DeviceScene(desc, scene, {s.camera_name: s for s in scene.sensors()},
                          shape_id_table(scene, object_ids, instance_ids), alpha_masked,
                          loaded_emitters(scene, desc.lights), moving, animated, entries, (object_ids, instance_ids),
-                         light_scales=(1.0,) * len(desc.lights))
+                         light_scales=(1.0,) * len(desc.lights),
+                         projectors={e.projector_name: e for e in scene.emitters()
+                                     if isinstance(e, projector_mod.ProjectorEmitter)})
     device.place_at(None)  # at frame 0, where the geometry was placed, hiding what is absent then
     for cam in desc.cameras.values():
         prepare_camera(cam)  # the truth pass's ray table, made here rather than in frame 0

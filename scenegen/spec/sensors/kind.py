@@ -18,7 +18,9 @@ from scenegen.geometry.pose import Rigid3
 #: What a kind produces: views (images + per-pixel truth, the pipeline's view path) or a stream.
 VIEWS = "views"
 STREAM = "stream"
-PRODUCTS = (VIEWS, STREAM)
+#: ... or light: the views of its rig's cameras are rendered under it (a projector's patterns).
+LIGHT = "light"
+PRODUCTS = (VIEWS, STREAM, LIGHT)
 #: The keys a rig member names its sensor and its pose with, for every kind.
 MEMBER_KEYS = ("sensor", "rig_from_sensor")
 
@@ -74,8 +76,8 @@ class SensorKind:
     (``cameras`` for cameras), None = ``SceneSpec.sensors[name]``. ``member_keys``: the keys a rig
     member names its sensor and its pose with, besides ``sensor`` / ``rig_from_sensor`` (the
     camera's ``camera`` / ``rig_from_cam``), also the keys of the member in the resolved spec.
-    ``time_offsets``: whether a member may sample off its rig's time. ``produces``: VIEWS or
-    STREAM; ``truth``: what each output holds (the camera: the per-pixel truth keys; a stream:
+    ``time_offsets``: whether a member may sample off its rig's time. ``produces``: VIEWS,
+    STREAM or LIGHT (the rig's views are rendered under it: :mod:`.projector`); ``truth``: what each output holds (the camera: the per-pixel truth keys; a stream:
     its field names). ``write(run: SensorRun)``: a stream kind's writer (None for views, which
     the pipeline renders). ``to_yaml(model) -> dict``: one sensor back to YAML (the camera's is
     ``scenegen.spec.to_yaml``'s own). ``check_view_set(member, sensor, view_set, node)``: a stream

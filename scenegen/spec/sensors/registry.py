@@ -9,6 +9,7 @@ from scenegen.spec.sensors.kind import SensorKind
 from scenegen.spec.sensors.lidar import LIDAR
 from scenegen.spec.sensors.wheel_odometry import WHEEL_ODOMETRY
 from scenegen.spec.sensors.tof import TOF
+from scenegen.spec.sensors.projector import PROJECTOR
 
 #: Sensor kind name -> SensorKind (a rig member's default kind: RigMember.kind, the camera).
 SENSOR_KINDS: dict[str, SensorKind] = {
@@ -17,6 +18,7 @@ SENSOR_KINDS: dict[str, SensorKind] = {
     LIDAR.name: LIDAR,
     WHEEL_ODOMETRY.name: WHEEL_ODOMETRY,
     TOF.name: TOF,
+    PROJECTOR.name: PROJECTOR,
 }
 
 

@@ -168,5 +168,5 @@ def test_every_kind_has_a_section_of_its_own(clock):
     assert len(set(sections)) == len(sections)
     sections_of_sensors = [k.section for k in SENSOR_KINDS.values() if k.spec_field is None]
     assert sections_of_sensors[0] == "imus" and sections_of_sensors[-1] == "clocks"  # the test kind joins last
-    assert {"lidars", "tof_cameras", "wheel_odometry"} <= set(sections_of_sensors)
+    assert {"lidars", "tof_cameras", "wheel_odometry", "projectors"} <= set(sections_of_sensors)
     assert all(k.section not in TOP_LEVEL_KEYS for k in SENSOR_KINDS.values() if k.spec_field is None)

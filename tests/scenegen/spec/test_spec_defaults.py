@@ -28,6 +28,7 @@ from scenegen.spec.sensors.imu import ImuSpec
 from scenegen.spec.sensors.lidar import LidarSpec
 from scenegen.spec.sensors.wheel_odometry import WheelOdometrySpec
 from scenegen.spec.sensors.tof import TofSpec
+from scenegen.spec.sensors.projector import ProjectorSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -219,6 +220,13 @@ CASES += [(TofSpec, k, TOF, lambda s, k=k: getattr(s.sensors["tof"]["t"], k), v)
                        ("contrast", 0.5), ("noise", False), ("read_noise_e", 1.0), ("gain_dn_per_e", 0.5),
                        ("full_well_e", 1000.0), ("adc_bits", 12), ("min_amplitude_e", 5.0),
                        ("flying_threshold_m", 0.1))]
+#: A projector of fixed defaults (its intrinsics required).
+PROJ = "projectors:\n  p: {intrinsics: {size: [16, 8], fx: 20}%s}\n"
+CASES += [(ProjectorSpec, k, PROJ % "", lambda s, k=k: getattr(s.sensors["projector"]["p"], k), v)
+          for k, v in (("intensity_w_sr", (2.0, 2.0, 2.0)), ("gamma", 2.2), ("black_level", 0.05), ("falloff", "cos4"),
+                       ("patterns", "binary"), ("pattern_axes", "rows"), ("pattern_inverse", False),
+                       ("pattern_white_black", False), ("phase_steps", 8), ("stripe_px", 2), ("dots_density", 0.5),
+                       ("dot_px", 2), ("linear_patterns", True))]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
