@@ -5,8 +5,8 @@ The projector pixel of a camera pixel is the projection of the view's stored ``p
 (float32, taken exactly, computed in float64) through the projector's model
 (:meth:`scenegen.geometry.camera.Camera.project`, distortion and skew included).
 The pixel a perfect decoder reads is the one whose square covers it: column ``floor(u + 0.5)``,
-row ``floor(v + 0.5)`` (OpenCV centres, :mod:`scenegen.geometry.conventions`), the same rule as
-the renderer's pattern lookup (:mod:`scenegen.render.projector`). A point is lit when that pixel
+row ``floor(v + 0.5)`` (:func:`scenegen.geometry.sl_codes.pixel_index`; OpenCV centres), the same
+rule as the renderer's pattern lookup (:mod:`scenegen.render.projector`). A point is lit when that pixel
 lies in the projector's image, the side of the surface the camera sees faces the projector
 centre, and the visibility cast from the projector centre reaches the point (a separate ray cast:
 projector shadows).
@@ -18,7 +18,7 @@ import numpy as np
 from scenegen.dataset.structured_light import ProjectorTruth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
-from scenegen.imaging.projector_sequences import gray_code
+from scenegen.geometry.sl_codes import OUTSIDE, binary_to_gray, pixel_index
 
 
 def projector_pixels(points_world, projector: Camera, projector_from_world: Rigid3) -> np.ndarray:
@@ -42,10 +42,10 @@ def projector_truth(points_world, normals_world, camera_center_world, projector:
     H, W = P.shape[:2]
     uv = projector_pixels(P, projector, projector_from_world)
     center = projector_from_world.inverse().t
+    col = pixel_index(uv[..., 0], projector.width)
+    row = pixel_index(uv[..., 1], projector.height)
+    inside = (col != OUTSIDE) & (row != OUTSIDE)
     with np.errstate(invalid="ignore"):
-        col = np.floor(uv[..., 0] + 0.5)
-        row = np.floor(uv[..., 1] + 0.5)
-        inside = (col >= 0) & (col < projector.width) & (row >= 0) & (row < projector.height)
         facing_cam = np.sign(np.einsum("hwk,hwk->hw", N, np.asarray(camera_center_world, np.float64) - P))
         facing_proj = np.einsum("hwk,hwk->hw", N, center - P) * facing_cam > 0
     lit = inside & facing_proj
@@ -55,7 +55,7 @@ def projector_truth(points_world, normals_world, camera_center_world, projector:
         flat = lit.ravel()
         flat[idx] = np.asarray(seen, bool)
         lit = flat.reshape(H, W)
-    column = np.where(lit, col, -1).astype(np.int32)
-    row_i = np.where(lit, row, -1).astype(np.int32)
-    gray = lambda a: np.where(a >= 0, gray_code(np.maximum(a, 0)), -1).astype(np.int32)
+    column = np.where(lit, col, OUTSIDE).astype(np.int32)
+    row_i = np.where(lit, row, OUTSIDE).astype(np.int32)
+    gray = lambda a: np.where(a >= 0, binary_to_gray(np.maximum(a, 0)), OUTSIDE).astype(np.int32)
     return ProjectorTruth(uv=uv, lit=lit, column=column, row=row_i, gray_column=gray(column), gray_row=gray(row_i))

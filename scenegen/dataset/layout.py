@@ -21,7 +21,7 @@ this project in docs/dataset_format.md and docs/crossview.md)::
     truth/<view>_projector.npz              a projector-lit view: projector pixel, lit mask, codes per pixel
     patterns/<view>/sequence.json           a projector-lit view: the projector, its pose and the patterns
     patterns/<view>/<k>.png                 the view under pattern k (k = 000, 001, ...; encoded as images/)
-    patterns/<view>/<k>_linear.exr          ... its clean linear float32 RGB
+    patterns/<view>/<k>_linear.exr          ... its clean linear float32 RGB (projector linear_patterns)
     raw/<view>.dng                          the sensor's raw mosaic as DNG (cameras with imaging.raw)
     images/<view>_raw.png                   the same mosaic as a 16-bit grey PNG (imaging.raw.png)
     crossview/index.json                    what cross-view truth the run wrote

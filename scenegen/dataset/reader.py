@@ -41,6 +41,8 @@ from scenegen.dataset.layout import (
     mesh_path,
     names_under,
     lights_path,
+    pattern_sequence_path,
+    projector_truth_path,
     target_path,
     view_paths,
     vignetting_path,
@@ -51,6 +53,7 @@ from scenegen.dataset.photometric import ViewLight, decode_albedo, decode_lights
 from scenegen.dataset.raw import RawImage, raw_image
 from scenegen.dataset.sequence_reader import SequenceTruth
 from scenegen.dataset.stream_reader import Streams
+from scenegen.dataset.structured_light import ProjectorTruth, decode_pattern_sequence, decode_projector_truth
 from scenegen.dataset.truth import LINEAR_CHANNELS, TRUTH_FLOAT_CHANNELS, TruthKind, decode_truth
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
@@ -276,6 +279,29 @@ class Dataset:
         rel = boxes_path(self.check_view(view))
         return self.read(rel, lambda p: decode_boxes(read_json(p), str(p)), f"boxes of view {view!r}") \
             if self.has(rel) else None
+
+    def projector_truth(self, view: str) -> ProjectorTruth | None:
+        """A projector-lit view's per-pixel projector truth (:class:`scenegen.dataset.structured_light
+        .ProjectorTruth`: projector pixel, lit mask, column/row and Gray codes), or None for a view
+        no projector lights."""
+        rel = projector_truth_path(self.check_view(view))
+        return self.read(rel, lambda p: decode_projector_truth(p.read_bytes()), f"projector truth of view {view!r}") \
+            if self.has(rel) else None
+
+    def pattern_sequence(self, view: str) -> dict | None:
+        """A projector-lit view's ``patterns/<view>/sequence.json`` (the projector's camera and pose,
+        radiometry, and each pattern with its image file), or None for a view no projector lights."""
+        rel = pattern_sequence_path(self.check_view(view))
+        return self.read(rel, lambda p: decode_pattern_sequence(read_json(p), str(p)),
+                         f"pattern sequence of view {view!r}") if self.has(rel) else None
+
+    def pattern_images(self, view: str) -> np.ndarray:
+        """(N, H, W[, 3]) the view's images under its projector's N patterns, in order."""
+        doc = self.pattern_sequence(view)
+        if doc is None:
+            raise DatasetError(f"view {view!r} is not lit by a projector (no {pattern_sequence_path(view)})")
+        return np.stack([self.read(check_rel_path(e["image"]), read_png, f"pattern {e.get('index')} of view {view!r}")
+                         for e in doc["patterns"]])
 
     def raw(self, view: str, kind: str | None = None) -> RawImage | None:
         """The raw mosaic of a view (:class:`scenegen.dataset.raw.RawImage`: uint16 DN, CFA,

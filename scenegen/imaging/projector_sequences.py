@@ -1,77 +1,85 @@
-"""The pattern sequences a projector shows, by name: :data:`SEQUENCES` (docs/scene_spec.md,
-"Projectors"). A sequence is a (N, H, W) float64 stack of pattern values in [0, 1] at the
-projector's resolution (pixel [r, c] is projector pixel column c, row r, OpenCV's convention);
-the projector's radiometry (:mod:`scenegen.spec.sensors.projector`) turns a value into light.
+"""The pattern sequences a projector of the spec shows, by name (:data:`SEQUENCES`), built by
+:mod:`scenegen.imaging.patterns` (the codes' rules: :mod:`scenegen.geometry.sl_codes`), and how
+each frame is described in a dataset's ``patterns/<view>/sequence.json`` (:func:`frame_entry`).
 
-``gray``: the structured-light sequence of Lanman and Taubin's desktop scanner: an all-white and
-an all-black image, then for each axis (columns, then rows) its reflected binary Gray code bits,
-most significant first, each followed by its inverse. Bit ``b`` of column ``c`` is bit ``b`` of
-``c ^ (c >> 1)``; ``bits`` of a W-wide axis is ceil(log2 W) (the codes of every column).
-``white``: one all-white image (the radiometry's reference).
+A builder takes the projector's size and :class:`SequenceOptions` and returns a
+:class:`scenegen.imaging.patterns.PatternSequence` (values in [0, 1], (N, H, W) or (N, H, W, 3));
+the projector's radiometry (:mod:`scenegen.spec.sensors.projector`) turns a value into light.
+``white`` is one all-white frame (the radiometry's reference).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-AXES = ("columns", "rows", "both")
+from scenegen.imaging import patterns
+from scenegen.imaging.patterns import FrameCode, PatternSequence
+
+#: The spec's coded axes -> the patterns' axes (u: columns, v: rows).
+AXES = {"columns": ("u",), "rows": ("v",), "both": ("u", "v")}
+AXIS_NAMES = {"u": "columns", "v": "rows", "": ""}
 
 
-def gray_code(index):
-    """The reflected binary Gray code of non-negative integers (numpy arrays or ints)."""
-    return index ^ (index >> 1)
+@dataclass(frozen=True, kw_only=True)
+class SequenceOptions:
+    """What a sequence is made with (the projector's spec values; each builder reads its own)."""
+
+    axes: str = "both"  # a key of AXES (De Bruijn stripes: the first of them)
+    inverses: bool = True  # gray / binary: each bit frame followed by its inverse
+    references: bool = True  # gray / binary: an all-white and an all-black frame first
+    phase_steps: int = 4
+    phase_periods_px: tuple[float, ...] | None = None  # None: patterns.default_periods_px
+    stripe_px: int = 4
+    dots_seed: int = 0
+    dots_density: float = 0.1
+    dot_px: int = 1
 
 
-def axis_bits(size: int) -> int:
-    """Bits that number ``size`` projector pixels along an axis: ceil(log2(size)), at least 1."""
-    return max(1, math.ceil(math.log2(size)))
+def _white(width: int, height: int, o: SequenceOptions) -> PatternSequence:
+    return PatternSequence(name="white", width=width, height=height, images=np.ones((1, height, width), np.float32),
+                           frames=(FrameCode(kind="white"),))
 
 
-@dataclass(frozen=True)
-class PatternImage:
-    """One pattern of a sequence: its values (H, W) in [0, 1] and what it codes: ``axis``
-    ('columns', 'rows' or '' for a plain image), ``bit`` (0 = least significant; -1 for a plain
-    image) and ``inverse``."""
-
-    values: np.ndarray
-    name: str
-    axis: str = ""
-    bit: int = -1
-    inverse: bool = False
-
-
-def gray_sequence(width: int, height: int, axes: str = "both", inverse: bool = True,
-                  white_black: bool = True) -> tuple[PatternImage, ...]:
-    """The Gray-code sequence (module docstring) of a ``width`` x ``height`` projector."""
-    if axes not in AXES:
-        raise ValueError(f"axes must be one of {AXES}, got {axes!r}")
-    out: list[PatternImage] = []
-    if white_black:
-        out += [PatternImage(np.ones((height, width)), "white"), PatternImage(np.zeros((height, width)), "black")]
-    for axis in ("columns", "rows"):
-        if axes not in (axis, "both"):
-            continue
-        n = width if axis == "columns" else height
-        code = gray_code(np.arange(n))
-        for b in reversed(range(axis_bits(n))):
-            line = ((code >> b) & 1).astype(np.float64)
-            img = np.broadcast_to(line[None, :] if axis == "columns" else line[:, None], (height, width)).copy()
-            out.append(PatternImage(img, f"{axis[:3]}_bit{b:02d}", axis, b, False))
-            if inverse:
-                out.append(PatternImage(1.0 - img, f"{axis[:3]}_bit{b:02d}_inv", axis, b, True))
-    return tuple(out)
-
-
-def white_sequence(width: int, height: int, **_) -> tuple[PatternImage, ...]:
-    """One all-white pattern."""
-    return (PatternImage(np.ones((height, width)), "white"),)
-
-
-#: Sequence name -> builder(width, height, axes=, inverse=, white_black=) -> patterns.
-SEQUENCES: dict[str, Callable[..., tuple[PatternImage, ...]]] = {
-    "gray": gray_sequence,
-    "white": white_sequence,
+#: Sequence name -> builder(width, height, SequenceOptions) -> PatternSequence.
+SEQUENCES: dict[str, Callable[[int, int, SequenceOptions], PatternSequence]] = {
+    "gray": lambda w, h, o: patterns.gray_code(w, h, axes=AXES[o.axes], inverses=o.inverses, references=o.references),
+    "binary": lambda w, h, o: patterns.binary_code(w, h, axes=AXES[o.axes], inverses=o.inverses,
+                                                   references=o.references),
+    "phase_shift": lambda w, h, o: patterns.phase_shift(w, h, n_steps=o.phase_steps, periods_px=o.phase_periods_px,
+                                                        axes=AXES[o.axes]),
+    "debruijn": lambda w, h, o: patterns.debruijn_stripes(w, h, stripe_px=o.stripe_px, axis=AXES[o.axes][0]),
+    "dots": lambda w, h, o: patterns.random_dots(w, h, seed=o.dots_seed, density=o.dots_density, dot_px=o.dot_px),
+    "white": _white,
 }
+
+
+def frame_name(f: FrameCode) -> str:
+    """A readable name of a frame: ``white``, ``black``, ``u_bit07`` (bit counted from the least
+    significant), ``u_bit07_inv``, ``u_phase_p256.0_s2``, ``debruijn_u``, ``dots``."""
+    if f.kind in ("gray", "binary"):
+        return f"{f.axis}_bit{f.n_bits - 1 - f.bit:02d}" + ("_inv" if f.inverse else "")
+    if f.kind == "phase":
+        return f"{f.axis}_phase_p{f.period_px:g}_s{f.step}"
+    if f.kind == "debruijn":
+        return f"debruijn_{f.axis}"
+    return f.kind
+
+
+def frame_entry(f: FrameCode) -> dict:
+    """A frame as ``sequence.json`` describes it: ``name``, ``kind``, ``axis`` (``columns`` /
+    ``rows`` / ``""``), ``bit`` (the code word's bit shown, 0 = least significant; -1 if none),
+    ``n_bits``, ``inverse``, and a phase frame's ``period_px``, ``step``, ``n_steps``,
+    ``shift_rad``, a De Bruijn frame's ``stripe_px``, ``symbols``, ``order``, a dot frame's
+    ``seed``, ``density``, ``dot_px``."""
+    d = {"name": frame_name(f), "kind": f.kind, "axis": AXIS_NAMES[f.axis],
+         "bit": f.n_bits - 1 - f.bit if f.kind in ("gray", "binary") else -1, "n_bits": f.n_bits,
+         "inverse": f.inverse}
+    if f.kind == "phase":
+        d.update(period_px=f.period_px, step=f.step, n_steps=f.n_steps, shift_rad=f.shift_rad)
+    elif f.kind == "debruijn":
+        d.update(stripe_px=f.stripe_px, symbols=f.symbols, order=f.order)
+    elif f.kind == "dots":
+        d.update(seed=f.seed, density=f.density, dot_px=f.dot_px)
+    return d

@@ -23,6 +23,7 @@ from scenegen.geometry.color import srgb_image
 from scenegen.geometry.pose import Rigid3
 from scenegen.geometry.seeds import hashed_seed32
 from scenegen.imaging import apply_chain
+from scenegen.imaging.projector_sequences import frame_entry
 from scenegen.imaging.seeds import frame_seed
 from scenegen.spec.sensors import LIGHT, SENSOR_KINDS
 
@@ -34,7 +35,7 @@ class LitView:
     member: object  # scenegen.spec.model.RigMember
     spec: object  # scenegen.spec.sensors.projector.ProjectorSpec
     projector_from_world: Rigid3
-    patterns: tuple  # scenegen.imaging.projector_sequences.PatternImage, in order
+    sequence: object  # scenegen.imaging.patterns.PatternSequence
 
 
 def lit_view(spec, view) -> LitView | None:
@@ -52,16 +53,16 @@ def lit_view(spec, view) -> LitView | None:
     # projector_from_world = projector_from_rig @ rig_from_cam @ cam_from_world
     projector_from_world = member.rig_from_sensor.inverse() @ cam_member.rig_from_sensor @ view.cam_from_world
     p = SENSOR_KINDS[member.kind].sensors_of(spec)[member.sensor]
-    return LitView(member, p, projector_from_world, p.pattern_images())
+    return LitView(member, p, projector_from_world, p.pattern_sequence())
 
 
 def render_patterns(built, view, lit: LitView, *, spp: int, seed: int, time_s) -> list[np.ndarray]:
     """Linear float32 (H, W, 3) renders of the view under each pattern; pattern k's sampler seed
     is hashed from the view's seed and k."""
     return [built.render_pattern(view.camera, view.cam_from_world, lit.member.sensor, lit.projector_from_world,
-                                 pat.values, spp=spp, seed=hashed_seed32(seed, k), motion=view.motion,
+                                 values, spp=spp, seed=hashed_seed32(seed, k), motion=view.motion,
                                  light_scales=view.light_scales, time_s=time_s)
-            for k, pat in enumerate(lit.patterns)]
+            for k, values in enumerate(lit.sequence.images)]
 
 
 def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, truth, visible) -> dict[str, bytes]:
@@ -72,7 +73,7 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
     params = spec.cameras[view.camera].imaging
     files = {}
     entries = []
-    for k, (pat, linear) in enumerate(zip(lit.patterns, linears)):
+    for k, (frame, linear) in enumerate(zip(lit.sequence.frames, linears)):
         if k == 0:
             image = image0
         elif params is None:
@@ -80,10 +81,11 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
         else:  # the chain's temporal noise drawn anew for each pattern
             image = apply_chain(linear, params, cam, hashed_seed32(frame_seed(spec.seed, index), k)).image
         files[pattern_image_path(view.name, k)] = encode_png(image)
-        files[pattern_linear_path(view.name, k)] = encode_exr(pack_channels("", linear.astype(np.float32),
-                                                                            LINEAR_CHANNELS))
-        entries.append({"index": k, "name": pat.name, "axis": pat.axis, "bit": pat.bit, "inverse": pat.inverse,
-                        "image": pattern_image_path(view.name, k), "linear": pattern_linear_path(view.name, k)})
+        entry = {"index": k, **frame_entry(frame), "image": pattern_image_path(view.name, k)}
+        if lit.spec.linear_patterns:
+            entry["linear"] = pattern_linear_path(view.name, k)
+            files[entry["linear"]] = encode_exr(pack_channels("", linear.astype(np.float32), LINEAR_CHANNELS))
+        entries.append(entry)
     p = lit.spec
     world_from_cam = view.cam_from_world.inverse()
     doc = {"format": PATTERNS_FORMAT, "view": view.name,
@@ -91,8 +93,7 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
                          "projector_from_world": lit.projector_from_world.matrix.tolist(),
                          "cam_from_projector": (view.cam_from_world @ lit.projector_from_world.inverse()).matrix.tolist(),
                          "intensity_w_sr": list(p.intensity_w_sr), "gamma": p.gamma, "black_level": p.black_level,
-                         "falloff": p.falloff, "sequence": p.patterns, "axes": p.pattern_axes,
-                         "inverse": p.pattern_inverse, "white_black": p.pattern_white_black},
+                         "falloff": p.falloff, "sequence": p.patterns},
            "patterns": entries}
     files[pattern_sequence_path(view.name)] = encode_json(doc)
     t = projector_truth(truth[TruthKind.POINTS_WORLD], truth[TruthKind.NORMALS_WORLD], world_from_cam.t,

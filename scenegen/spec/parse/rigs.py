@@ -12,7 +12,7 @@ from scenegen.spec.parse.cameras import camera_ref
 from scenegen.spec.parse.context import ParseContext
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.parse.transforms import parse_pose
-from scenegen.spec.sensors import MEMBER_KEYS, SENSOR_KINDS, SensorKind
+from scenegen.spec.sensors import LIGHT, MEMBER_KEYS, SENSOR_KINDS, SensorKind
 
 STEREO_MEMBERS = ("left", "right")
 
@@ -49,6 +49,10 @@ def parse_rig(node: Node, name: str, ctx: ParseContext) -> Rig:
             raise where.error(f"duplicate member name {member.name!r} in rig {name!r} (first at "
                               f"line {seen[member.name]}); give each member a distinct 'name'")
         seen[member.name] = item.line
+        lights = [mb for mb in members if SENSOR_KINDS[mb.kind].produces == LIGHT]
+        if SENSOR_KINDS[member.kind].produces == LIGHT and lights:
+            raise item.error(f"rig {name!r} holds the {lights[0].kind} {lights[0].name!r} already; its views are "
+                             "lit by one at most")
         members.append(member)
     if not members:
         raise f.get("members").error("expected at least one rig member, got an empty list")

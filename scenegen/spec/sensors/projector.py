@@ -26,10 +26,11 @@ from typing import Any
 import numpy as np
 
 from scenegen.errors import Where
-from scenegen.imaging.projector_sequences import AXES, SEQUENCES, PatternImage
-from scenegen.spec.model.meta import param, part, where_field
+from scenegen.imaging.patterns import PatternSequence
+from scenegen.imaging.projector_sequences import AXES, SEQUENCES, SequenceOptions
+from scenegen.spec.model.meta import SEED_MAX, field_info, param, part, where_field
 from scenegen.spec.parse.cameras import parse_camera
-from scenegen.spec.parse.fields import check_keys, read_fields, write_fields
+from scenegen.spec.parse.fields import check_keys, read_fields, read_value, write_fields
 from scenegen.spec.sensors.kind import LIGHT, SensorKind
 
 FALLOFF_EXPONENTS = {"none": 0, "cos4": 4}
@@ -49,9 +50,18 @@ class ProjectorSpec:
     black_level: float = param(0.0, unit="fraction of white", lo=0.0, hi=1.0, hi_open=True)  # a black pixel's light
     falloff: str = param("none", unit="fall-off law", choices=tuple(FALLOFF_EXPONENTS))
     patterns: str = param("gray", unit="pattern sequence", choices=tuple(SEQUENCES))
-    pattern_axes: str = param("both", unit="coded axes", choices=AXES)
-    pattern_inverse: bool = param(True, unit="flag")  # each bit pattern followed by its inverse
-    pattern_white_black: bool = param(True, unit="flag")  # an all-white and an all-black pattern first
+    pattern_axes: str = param("both", unit="coded axes", choices=tuple(AXES))  # De Bruijn: the first
+    pattern_inverse: bool = param(True, unit="flag")  # gray/binary: each bit pattern followed by its inverse
+    pattern_white_black: bool = param(True, unit="flag")  # gray/binary: an all-white and an all-black pattern first
+    phase_steps: int = param(4, unit="steps per period", lo=3, hi=64)  # phase_shift
+    phase_periods_px: tuple[float, ...] | None = param(
+        None, unit="projector pixels, coarsest first", lo=0.0, lo_open=True,
+        doc_default="the axis length, then 8 times finer while >= 8 px")  # phase_shift
+    stripe_px: int = param(4, unit="projector pixels", lo=1, hi=4096)  # debruijn: stripe width
+    dots_density: float = param(0.1, unit="fraction of lit dots", lo=0.0, lo_open=True, hi=1.0)  # dots
+    dot_px: int = param(1, unit="projector pixels", lo=1, hi=4096)  # dots: dot size
+    seed: int = param(0, unit="seed", label="", lo=0, hi=SEED_MAX, derived="seed32(scene seed, field path)")  # dots
+    linear_patterns: bool = param(False, unit="flag")  # also write each pattern's clean linear EXR
     where: Where | None = where_field()
 
     @property
@@ -62,11 +72,13 @@ class ProjectorSpec:
         """The projector's :class:`scenegen.geometry.camera.Camera`."""
         return self.intrinsics.to_camera()
 
-    def pattern_images(self) -> tuple[PatternImage, ...]:
+    def pattern_sequence(self) -> PatternSequence:
         """The sequence it shows, in order, at its resolution."""
         c = self.intrinsics
-        return SEQUENCES[self.patterns](c.width, c.height, axes=self.pattern_axes, inverse=self.pattern_inverse,
-                                        white_black=self.pattern_white_black)
+        return SEQUENCES[self.patterns](c.width, c.height, SequenceOptions(
+            axes=self.pattern_axes, inverses=self.pattern_inverse, references=self.pattern_white_black,
+            phase_steps=self.phase_steps, phase_periods_px=self.phase_periods_px, stripe_px=self.stripe_px,
+            dots_seed=self.seed, dots_density=self.dots_density, dot_px=self.dot_px))
 
     def relative_output(self, values) -> np.ndarray:
         """(…) float64 emitted fraction of ``intensity_w_sr`` for pattern values in [0, 1] (clipped)."""
@@ -82,10 +94,18 @@ def parse_projector(node, name, ctx) -> ProjectorSpec:
     inode = f.get(_INTRINSICS)
     cam = parse_camera(inode, name, ctx)
     if cam.optics is not None or cam.imaging is not None:
-        bad = next(k for k in inode.as_mapping() if k not in _CAMERA_KEYS)
+        bad = next(k for k in inode.as_mapping().keys() if k not in _CAMERA_KEYS)
         raise inode.as_mapping().get(bad).error("a projector's intrinsics take the camera model keys only "
                                                 f"({', '.join(_CAMERA_KEYS)}); got {bad!r}")
-    return ProjectorSpec(name=name, intrinsics=cam, where=node.where, **read_fields(f, ProjectorSpec))
+    values = read_fields(f, ProjectorSpec)
+    values["seed"] = (read_value(f.get("seed"), field_info(ProjectorSpec, "seed")) if "seed" in f
+                      else ctx.seed_for(node.path))
+    p = ProjectorSpec(name=name, intrinsics=cam, where=node.where, **values)
+    try:
+        p.pattern_sequence()  # e.g. phase periods shorter than the projector's axis
+    except ValueError as e:
+        raise (f.get("phase_periods_px") or node).error(f"pattern sequence {p.patterns!r}: {e}") from None
+    return p
 
 
 _CAMERA_KEYS = ("model", "size", "fx", "fy", "cx", "cy", "skew", "dist", "fov_deg", "mask_beyond_fold")
