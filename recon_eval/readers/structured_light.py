@@ -37,7 +37,8 @@ SOURCES = ("png", "linear")
 
 @dataclass(frozen=True)
 class PatternFrame:
-    """What one stored pattern codes: ``kind`` white / black / gray / phase / other."""
+    """What one stored pattern codes: ``kind`` white / black / gray / binary / phase / other (the
+    file's ``kind`` where it gives one; an entry with an axis and a bit and no kind is Gray)."""
 
     kind: str
     axis: str = ""  # "u" or "v"
@@ -77,8 +78,9 @@ def _frame(entry: dict, projector: Camera, source: str) -> PatternFrame:
             return PatternFrame("phase", axis, period_px=float(entry["period_px"]), step=int(entry["step"]),
                                 shift_rad=float(entry["shift_rad"]))
         if axis and int(entry.get("bit", -1)) >= 0:
-            n = bits_for(projector.width if axis == "u" else projector.height)
-            return PatternFrame("gray", axis, n - 1 - int(entry["bit"]), n, bool(entry.get("inverse", False)))
+            kind = "binary" if entry.get("kind") == "binary" else "gray"
+            n = int(entry.get("n_bits") or bits_for(projector.width if axis == "u" else projector.height))
+            return PatternFrame(kind, axis, n - 1 - int(entry["bit"]), n, bool(entry.get("inverse", False)))
     except (KeyError, TypeError, ValueError) as e:
         raise InputError(f"{source}: pattern {entry.get('index')}: unreadable entry ({e})") from None
     return PatternFrame("other", axis)
@@ -106,6 +108,9 @@ def _read_view(ds: Dataset, view: str, source: str) -> ProjectorView:
             raise InputError(f"{where}: a pattern entry without an 'image' path")
         frames.append(_frame(entry, projector, where))
         if source == "linear":
+            if not isinstance(entry.get("linear"), str):
+                raise InputError(f"{where}: pattern {entry.get('index')}: no linear render ('linear'); "
+                                 f"read the images instead")
             lin = ds.read(entry["linear"], lambda p: unpack_channels(read_exr(p), "", LINEAR_CHANNELS), "pattern")
             images.append(np.asarray(lin, np.float64).mean(axis=2))
         else:

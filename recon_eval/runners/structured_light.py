@@ -45,23 +45,26 @@ def _frames(pv: ProjectorView, kind: str) -> list[int]:
 
 
 def decode_gray_view(pv: ProjectorView, threshold: float, min_contrast: float) -> np.ndarray:
-    """(H, W, 2) float64 decoded (column, row), NaN where none (an axis not coded: NaN)."""
+    """(H, W, 2) float64 decoded (column, row), NaN where none (an axis not coded: NaN); Gray or
+    plain binary code words, as the frames say."""
     white, black = (_frames(pv, k) for k in ("white", "black"))
     if not white or not black:
         raise NotApplicable(f"view {pv.view!r}: the Gray-code decoder needs the white and black frames")
     w, b = pv.images[white[0]], pv.images[black[0]]
     mask = contrast_mask(w, b, min_contrast)
     out = np.full(w.shape + (2,), np.nan)
+    coded = [f.kind for f in pv.frames if f.kind in ("gray", "binary")]
+    kind = coded[0] if coded else "gray"
     for a, axis in enumerate(("u", "v")):
-        bits = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == "gray" and f.axis == axis and not f.inverse)
-        inv = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == "gray" and f.axis == axis and f.inverse)
+        bits = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == kind and f.axis == axis and not f.inverse)
+        inv = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == kind and f.axis == axis and f.inverse)
         if not bits:
             continue
         if [x for x, _ in bits] != [x for x, _ in inv]:
             raise NotApplicable(f"view {pv.view!r}: axis {axis}: every bit needs its inverse")
         length = pv.projector.width if axis == "u" else pv.projector.height
         d = decode_axis(pv.images[[i for _, i in bits]], pv.images[[i for _, i in inv]], length_px=length,
-                        threshold=threshold * (w - b), mask=mask)
+                        threshold=threshold * (w - b), gray=kind == "gray", mask=mask)
         out[..., a] = np.where(d.code >= 0, d.code, np.nan)
     return out
 
