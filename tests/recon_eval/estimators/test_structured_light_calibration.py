@@ -1,6 +1,8 @@
 """Projector calibration from synthetic board corners: each camera pixel's code is the projector
 pixel of its ray's hit on the board plane (closed form, the projector's own model), the corners
 are carried into the projector by local homographies (Moreno and Taubin), then calibrateCamera."""
+import functools
+
 import cv2
 import numpy as np
 
@@ -27,10 +29,15 @@ EYES = [(0.0, 0.0, 0.54), (0.15, 0.06, 0.51), (-0.15, 0.06, 0.51), (0.03, 0.18, 
         (0.21, -0.12, 0.48), (-0.21, 0.12, 0.48), (-0.08, -0.08, 0.60)]
 
 
+@functools.cache
+def _camera_rays() -> np.ndarray:
+    return CAMERA.unproject_unit(pixel_centers(CAMERA.width, CAMERA.height).reshape(-1, 2))
+
+
 def _pose_codes(cam_from_board: Rigid3):
     """(H, W, 2) integer codes of the board plane (z = 0 of the board frame) and the camera corners."""
     proj_from_board = PROJ_FROM_CAM @ cam_from_board
-    d = CAMERA.unproject_unit(pixel_centers(CAMERA.width, CAMERA.height).reshape(-1, 2))
+    d = _camera_rays()
     board_from_cam = cam_from_board.inverse()
     o, db = board_from_cam.t, board_from_cam.rotate(d)
     t = -o[2] / db[:, 2]
