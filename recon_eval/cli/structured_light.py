@@ -56,14 +56,13 @@ def score(a):
 
 
 def metrics(a, res) -> dict:
-    """``metrics`` of ``codes --json``: the names an ``sl-*`` run gives the same numbers, per view."""
+    """``metrics`` of ``codes --json``: the names an ``sl-*`` run gives its pooled numbers (one
+    view here; ``fscore``: that view's, the run's ``fscore_mean`` over its views)."""
     c = res["codes"]
-    view = a.view or ""
-    pre = f"{view}." if view else ""
-    out = {f"{pre}code_agreement": c.agreement, f"{pre}code_agreement_decoded": c.agreement_decoded,
-           f"{pre}code_completeness": c.completeness, f"{pre}code_err_mean_px": c.mean_px}
+    out = {"code_agreement": c.agreement, "code_agreement_decoded": c.agreement_decoded,
+           "code_completeness": c.completeness, "code_err_mean_px": c.mean_px}
     if "cloud" in res:
-        out[f"{pre}fscore"] = res["cloud"].fscore
+        out["fscore"] = res["cloud"].fscore
     return out
 
 

@@ -11,7 +11,8 @@
 * ``phase``: N-step phase at each period, hierarchical temporal unwrapping
   (:mod:`recon_eval.estimators.structured_light.phase`), the ray against the continuous column.
 
-Scores per view and pooled over views (:mod:`recon_eval.metrics.structured_light`): code
+Scores per view (``results``) and pooled over the views (``metrics``; the views' mean F-score
+``fscore_mean``) (:mod:`recon_eval.metrics.structured_light`): code
 agreement with the truth codes over the lit pixels, code error (projector px), completeness;
 depth error against the truth depth and the fraction within each pixel's quantisation bound
 (half a projector column along the ray); Tanks and Temples F-score at ``tau_m`` and Chamfer
@@ -119,21 +120,13 @@ def score_view(pv: ProjectorView, codes: np.ndarray, points_world: np.ndarray, b
     return res
 
 
-def _headline(res: dict, prefix: str) -> dict:
-    c, d, t = res["codes"], res["depth"], res["cloud"]
-    return {f"{prefix}code_agreement": c.agreement, f"{prefix}code_agreement_decoded": c.agreement_decoded,
-            f"{prefix}code_completeness": c.completeness, f"{prefix}code_err_mean_px": c.mean_px,
-            f"{prefix}depth_mean_abs_mm": 1e3 * d.mean_abs_m, f"{prefix}depth_rms_mm": 1e3 * d.rms_m,
-            f"{prefix}depth_within_bound": d.within_bound_frac, f"{prefix}fscore": t.fscore}
-
-
 def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
     triangulation = str(options.get("triangulation", "plane"))
     if triangulation not in TRIANGULATIONS:
         raise ValueError(f"triangulation must be one of {TRIANGULATIONS}, got {triangulation!r}")
     tau_m = float(options.get("tau_m", 0.001))
     views = projector_views(ds.root, source=str(options.get("source", "png")))
-    results, metrics, raw, pooled = {}, {}, [], {"dec": [], "code": [], "lit": [], "depth": [], "gt": [], "bound": []}
+    results, metrics, raw, fscores, pooled = {}, {}, [], [], {"dec": [], "code": [], "lit": [], "depth": [], "gt": [], "bound": []}
     for pv in views:
         codes = decode(pv)
         pts, bound = triangulate_view(pv, codes, triangulation)
@@ -146,7 +139,7 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
         back[ok] = read_geometry(out_path(out_dir, f"{pv.view}/cloud.ply")).vertices
         r = score_view(pv, back_codes, back, bound, tau_m, continuous)
         results.update({f"{pv.view}.{k}": v for k, v in r.items()})
-        metrics.update(_headline(r, f"{pv.view}."))
+        fscores.append(r["cloud"].fscore)
         for key, val in (("dec", back_codes), ("code", pv.truth_code), ("lit", pv.lit),
                          ("depth", pv.cam_from_world.apply(back)[..., 2]), ("gt", pv.depth_z), ("bound", bound)):
             pooled[key].append(val.reshape(-1, *val.shape[2:]))
@@ -160,7 +153,8 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
     metrics.update({"code_agreement": c.agreement, "code_agreement_decoded": c.agreement_decoded,
                     "code_completeness": c.completeness, "code_err_mean_px": c.mean_px,
                     "depth_mean_abs_mm": 1e3 * d.mean_abs_m, "depth_rms_mm": 1e3 * d.rms_m,
-                    "depth_p95_mm": 1e3 * d.p95_abs_m, "depth_within_bound": d.within_bound_frac})
+                    "depth_p95_mm": 1e3 * d.p95_abs_m, "depth_within_bound": d.within_bound_frac,
+                    "fscore_mean": float(np.mean(fscores))})
     notes = {"views": [pv.view for pv in views], "triangulation": triangulation, "tau_m": tau_m,
              "options": dict(options)}
     return RunOutput(results, metrics, raw, notes)
