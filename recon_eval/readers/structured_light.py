@@ -117,6 +117,10 @@ def _read_view(ds: Dataset, view: str, source: str) -> ProjectorView:
             images.append(_grey(ds.read(entry["image"], read_png, "pattern image")))
     t = ds.read(projector_truth_path(view), lambda p: decode_projector_truth(p.read_bytes()), "projector truth")
     camera, cam_from_world = ds.camera(view)
+    for entry, img in zip(doc["patterns"], images):
+        if img.shape != (camera.height, camera.width) or t.lit.shape != img.shape:
+            raise InputError(f"{ds.path(entry['image'])}: a {img.shape} image (projector truth {t.lit.shape}); "
+                             f"the view's camera is {camera.height} x {camera.width}")
     depth = ds.depth_z(view).astype(np.float64)
     return ProjectorView(view, camera, cam_from_world, projector, projector_from_world, tuple(frames),
                          np.stack(images), t.uv, np.stack([t.column, t.row], axis=2).astype(np.int64), t.lit,

@@ -2,6 +2,7 @@
 (tests/recon_eval/conftest.py: a plane and a sphere, the Gray-code sequence sampled at each camera
 pixel centre's exact projector coordinate, stored as the renderer stores it)."""
 import json
+import shutil
 
 import numpy as np
 import pytest
@@ -62,3 +63,15 @@ def test_codes_command_scores_a_code_map_and_refuses_a_wrong_shape(gray_run, sl_
     assert cli_main(["codes", str(bad), str(sl_dataset), "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.npy" in err[0] and "(120, 160, 2)" in err[0]
+
+
+@pytest.mark.parametrize("doc", ['{"format": "scenegen.patterns/1"}', '[1, 2]',
+                                 '{"format": "scenegen.patterns/1", "projector": {}, "patterns": [{"index": 0}]}'])
+def test_a_broken_sequence_file_is_one_line_and_exit_2(sl_dataset, tmp_path, capsys, doc):
+    root = tmp_path / "ds"
+    shutil.copytree(sl_dataset, root)
+    (root / "patterns" / "scan_0000" / "sequence.json").write_text(doc)
+    capsys.readouterr()
+    assert cli_main(["run", "sl-gray-code", str(root), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "sequence.json" in err[0] and "Traceback" not in err[0]
