@@ -33,10 +33,12 @@ def projector_pixels(points_world, projector: Camera, projector_from_world: Rigi
 
 
 def projector_truth(points_world, normals_world, camera_center_world, projector: Camera,
-                    projector_from_world: Rigid3, visible) -> ProjectorTruth:
+                    projector_from_world: Rigid3, visible, corner_points_world) -> ProjectorTruth:
     """The truth of one view (module docstring). ``points_world``, ``normals_world``: (H, W, 3)
     as stored (NaN = no surface); ``visible(center (3,), points (N, 3)) -> (N,) bool``: the
-    visibility cast of the scene at the view's time."""
+    visibility cast of the scene at the view's time; ``corner_points_world`` (H + 1, W + 1, 3):
+    the points seen through the pixel corners (OpenCV (u, v) = (i - 0.5, j - 0.5), NaN = none),
+    for the clear masks."""
     P = np.asarray(points_world, np.float64)
     N = np.asarray(normals_world, np.float64)
     H, W = P.shape[:2]
@@ -58,4 +60,26 @@ def projector_truth(points_world, normals_world, camera_center_world, projector:
     column = np.where(lit, col, OUTSIDE).astype(np.int32)
     row_i = np.where(lit, row, OUTSIDE).astype(np.int32)
     gray = lambda a: np.where(a >= 0, binary_to_gray(np.maximum(a, 0)), OUTSIDE).astype(np.int32)
-    return ProjectorTruth(uv=uv, lit=lit, column=column, row=row_i, gray_column=gray(column), gray_row=gray(row_i))
+    clear_column, clear_row = _clear(corner_points_world, projector, projector_from_world, center, visible,
+                                     lit, column, row_i)
+    return ProjectorTruth(uv=uv, lit=lit, column=column, row=row_i, gray_column=gray(column), gray_row=gray(row_i),
+                          clear_column=clear_column, clear_row=clear_row)
+
+
+def _clear(corners, projector: Camera, projector_from_world: Rigid3, center, visible, lit, column, row):
+    """(clear_column, clear_row) (H, W) bool: lit pixels whose four corner rays meet points the
+    projector lights (inside its image, nothing between) in the pixel's own column (row)."""
+    C = np.asarray(corners, np.float64)
+    cuv = projector_pixels(C, projector, projector_from_world)
+    ccol = pixel_index(cuv[..., 0], projector.width)
+    crow = pixel_index(cuv[..., 1], projector.height)
+    seen = (ccol != OUTSIDE) & (crow != OUTSIDE)
+    idx = np.flatnonzero(seen.ravel())
+    if len(idx):
+        flat = seen.ravel()
+        flat[idx] = np.asarray(visible(center, C.reshape(-1, 3)[idx]), bool)
+        seen = flat.reshape(seen.shape)
+    quad = lambda a: (a[:-1, :-1], a[:-1, 1:], a[1:, :-1], a[1:, 1:])
+    corners_seen = np.logical_and.reduce(quad(seen))
+    same = lambda c, own: np.logical_and.reduce([q == own for q in quad(c)])
+    return lit & corners_seen & same(ccol, column), lit & corners_seen & same(crow, row)

@@ -8,7 +8,10 @@
   image, the side of the surface the camera sees facing the projector, nothing between them);
   ``projector_column`` / ``projector_row`` (H, W) int32: the projector pixel ``floor(u + 0.5)``,
   ``floor(v + 0.5)`` a perfect decoder reads, and ``gray_column`` / ``gray_row`` their Gray codes
-  ``c ^ (c >> 1)``; -1 where not lit.
+  ``c ^ (c >> 1)``; -1 where not lit; ``clear_column`` / ``clear_row`` (H, W) bool: lit, and
+  the rays through the pixel's four corners meet lit points in the same projector column (row):
+  the pixel's footprint lies in one column, so its code is unambiguous (a pixel straddling a
+  column edge, a shadow edge or a depth edge mixes codes and a decoder may read either).
 * ``patterns/<view>/sequence.json``: ``{"format": "scenegen.patterns/1", "view", "projector":
   {name, camera (Camera.to_dict), projector_from_world 4x4, cam_from_projector 4x4, radiometry},
   "patterns": [{index, name, axis, bit, inverse, image, linear}]}``.
@@ -36,10 +39,13 @@ class ProjectorTruth:
     row: np.ndarray
     gray_column: np.ndarray
     gray_row: np.ndarray
+    clear_column: np.ndarray
+    clear_row: np.ndarray
 
     def arrays(self) -> dict[ProjectorTruthKind, np.ndarray]:
         return {K.PROJECTOR_UV: self.uv, K.PROJECTOR_LIT: self.lit, K.PROJECTOR_COLUMN: self.column,
-                K.PROJECTOR_ROW: self.row, K.GRAY_COLUMN: self.gray_column, K.GRAY_ROW: self.gray_row}
+                K.PROJECTOR_ROW: self.row, K.GRAY_COLUMN: self.gray_column, K.GRAY_ROW: self.gray_row,
+                K.CLEAR_COLUMN: self.clear_column, K.CLEAR_ROW: self.clear_row}
 
 
 def encode_projector_truth(t: ProjectorTruth) -> bytes:
@@ -66,7 +72,7 @@ def decode_projector_truth(data: bytes) -> ProjectorTruth:
             raise ValueError(f"member {kind}.npy: expected {np.dtype(info.dtype)} {want}, got {a.dtype} {a.shape}")
     g = lambda k: arrays[str(k)]
     return ProjectorTruth(g(K.PROJECTOR_UV), g(K.PROJECTOR_LIT), g(K.PROJECTOR_COLUMN), g(K.PROJECTOR_ROW),
-                          g(K.GRAY_COLUMN), g(K.GRAY_ROW))
+                          g(K.GRAY_COLUMN), g(K.GRAY_ROW), g(K.CLEAR_COLUMN), g(K.CLEAR_ROW))
 
 
 def decode_pattern_sequence(doc, source: str) -> dict:

@@ -90,6 +90,8 @@ class ProjectorTruthKind(str, Enum):
     PROJECTOR_ROW = "projector_row"
     GRAY_COLUMN = "gray_column"
     GRAY_ROW = "gray_row"
+    CLEAR_COLUMN = "clear_column"
+    CLEAR_ROW = "clear_row"
 
     __str__ = str.__str__
     __format__ = str.__format__
@@ -111,4 +113,10 @@ PROJECTOR_TRUTH_INFO: dict[ProjectorTruthKind, TruthKindInfo] = {
         np.int32, None, None, "Gray code of the column: c ^ (c >> 1), where lit", "projector", -1),
     ProjectorTruthKind.GRAY_ROW: TruthKindInfo(
         np.int32, None, None, "Gray code of the row: r ^ (r >> 1), where lit", "projector", -1),
+    ProjectorTruthKind.CLEAR_COLUMN: TruthKindInfo(
+        np.bool_, None, None, "bool: lit, and the pixel's four corners see lit points of the same projector column",
+        "projector", False),
+    ProjectorTruthKind.CLEAR_ROW: TruthKindInfo(
+        np.bool_, None, None, "bool: lit, and the pixel's four corners see lit points of the same projector row",
+        "projector", False),
 }

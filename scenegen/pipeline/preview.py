@@ -58,7 +58,8 @@ def preview(spec_path, png=None, *, spp: int = 4, max_width: int = 160, variant:
     rows = []
     with ViewProgress(progress, len(views), label="preview") as bar:
         for index, v in enumerate(views):
-            image, _, truth, _ = render_view_data(small, built, index, v, spp=spp, seed=small.render.seed)
+            image, _, truth, _ = render_view_data(small, built, index, v, spp=spp, seed=small.render.seed,
+                                                  all_patterns=False)
             tiles, extra = view_tiles(image, truth, max_width)
             rows.append((f"{v.name}: {extra}", tiles))
             bar.advance()

@@ -56,13 +56,14 @@ def lit_view(spec, view) -> LitView | None:
     return LitView(member, p, projector_from_world, p.pattern_sequence())
 
 
-def render_patterns(built, view, lit: LitView, *, spp: int, seed: int, time_s) -> list[np.ndarray]:
-    """Linear float32 (H, W, 3) renders of the view under each pattern; pattern k's sampler seed
-    is hashed from the view's seed and k."""
+def render_patterns(built, view, lit: LitView, *, spp: int, seed: int, time_s, count: int | None = None
+                    ) -> list[np.ndarray]:
+    """Linear float32 (H, W, 3) renders of the view under each pattern (the first ``count``;
+    None: all); pattern k's sampler seed is hashed from the view's seed and k."""
     return [built.render_pattern(view.camera, view.cam_from_world, lit.member.sensor, lit.projector_from_world,
                                  values, spp=spp, seed=hashed_seed32(seed, k), motion=view.motion,
                                  light_scales=view.light_scales, time_s=time_s)
-            for k, values in enumerate(lit.sequence.images)]
+            for k, values in enumerate(lit.sequence.images[:count])]
 
 
 def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, truth, visible) -> dict[str, bytes]:
@@ -96,7 +97,10 @@ def pattern_files(spec, built, index: int, view, lit: LitView, linears, image0, 
                          "falloff": p.falloff, "sequence": p.patterns},
            "patterns": entries}
     files[pattern_sequence_path(view.name)] = encode_json(doc)
+    u, v = np.meshgrid(np.arange(cam.width + 1) - 0.5, np.arange(cam.height + 1) - 0.5)
+    corners = built.surface_points(cam, view.cam_from_world, np.stack([u.ravel(), v.ravel()], axis=1),
+                                   time_s=getattr(view, "time_s", None)).reshape(cam.height + 1, cam.width + 1, 3)
     t = projector_truth(truth[TruthKind.POINTS_WORLD], truth[TruthKind.NORMALS_WORLD], world_from_cam.t,
-                        p.to_camera(), lit.projector_from_world, visible)
+                        p.to_camera(), lit.projector_from_world, visible, corners)
     files[projector_truth_path(view.name)] = encode_projector_truth(t)
     return files

@@ -147,15 +147,18 @@ def view_truth(built, view, as_stored: bool = False) -> dict[str, np.ndarray]:
                        as_stored=as_stored, row_moves=moves, time_s=view_time(view))
 
 
-def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
+def render_view_data(spec, built, index: int, v, *, spp: int, seed: int, all_patterns: bool = True):
     """One view's (image, linear_rgb, truth as stored, extra files or None), ready for
-    :func:`scenegen.dataset.view_files.encode_view`; ``index`` is the view's position in the run."""
+    :func:`scenegen.dataset.view_files.encode_view`; ``index`` is the view's position in the run.
+    A projector-lit view is rendered under every pattern, or with ``all_patterns=False`` (a
+    preview) under its first only, without its pattern files."""
     lit = lit_view(spec, v)  # a projector in the view's rig: one render per pattern, the first is the view's
     if lit is None:
         linear = built.render(v.camera, v.cam_from_world, spp=spp, seed=view_seed(seed, index), motion=v.motion,
                               light_scales=v.light_scales, time_s=view_time(v))  # a sequence's frame: at its time
     else:
-        linears = render_patterns(built, v, lit, spp=spp, seed=view_seed(seed, index), time_s=view_time(v))
+        linears = render_patterns(built, v, lit, spp=spp, seed=view_seed(seed, index), time_s=view_time(v),
+                                  count=None if all_patterns else 1)
         linear = linears[0]
     truth = view_truth(built, v, as_stored=True)
     params = spec.cameras[v.camera].imaging
@@ -168,7 +171,7 @@ def render_view_data(spec, built, index: int, v, *, spp: int, seed: int):
     if spec.truth is not None and (spec.truth.albedo or spec.truth.lights or spec.truth.defocus
                                    or spec.truth.boxes):
         extra = {**(extra or {}), **requested_truth_files(spec, built, v, truth)}
-    if lit is not None:
+    if lit is not None and all_patterns:
         extra = {**(extra or {}), **pattern_files(spec, built, index, v, lit, linears, image, truth,
                                                   visible_at(built, view_time(v)))}
     return image, linear, truth, extra

@@ -82,7 +82,8 @@ class ProjectorEmitter(mi.Emitter):
 
     def intensity_toward(self, p_world, active=True):
         """(radiant intensity W/sr per channel toward world points, the points' OpenCV pixel u, v
-        in the projector): zero outside its image, behind it or beyond its fold."""
+        in the projector): zero outside its image and where its model does not project (behind a
+        perspective projector, beyond its fold), as :func:`project_xyz` says."""
         R, t = self.R, self.t
         X = R[0][0] * p_world.x + R[0][1] * p_world.y + R[0][2] * p_world.z + t[0]
         Y = R[1][0] * p_world.x + R[1][1] * p_world.y + R[1][2] * p_world.z + t[1]
@@ -90,7 +91,7 @@ class ProjectorEmitter(mi.Emitter):
         u, v, valid = project_xyz(X, Y, Z, self.p, self.model, DRJIT_OPS)
         col = mi.Int32(dr.floor(u + 0.5))
         row = mi.Int32(dr.floor(v + 0.5))
-        inside = active & valid & (Z > 0) & (col >= 0) & (row >= 0) & (col < self.width) & (row < self.height)
+        inside = active & valid & (col >= 0) & (row >= 0) & (col < self.width) & (row < self.height)
         index = mi.UInt32(dr.select(inside, row * self.width + col, 0))
         value = mi.Color3f(*[dr.gather(mi.Float, ch, index, inside) for ch in self.pattern])
         if self.falloff_exponent:

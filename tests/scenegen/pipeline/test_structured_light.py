@@ -124,16 +124,15 @@ def test_a_gray_code_decode_of_the_patterns_reads_the_truth_codes(rendered):
     bits = [(e["bit"], imgs[e["index"]], imgs[e["index"] + 1]) for e in seq["patterns"]
             if e["axis"] == "columns" and not e["inverse"]]
     gray = sum(((pos > neg).astype(np.int64) << b) for b, pos, neg in bits)
-    # a camera pixel whose footprint straddles a projector column edge (or a shadow edge) sees two
-    # codes and may read either; one whose footprint (half its extent in projector columns, from
-    # the truth of its neighbours) lies within one lit column reads exactly that column's code
-    u = t.uv[..., 0]
-    du_dy, du_dx = np.gradient(u)
-    half = 0.5 * (np.abs(du_dx) + np.abs(du_dy))
-    frac = u + 0.5 - np.floor(u + 0.5)
-    lit_around = t.lit & np.all([np.roll(t.lit, s, axis=a) for s in (-1, 1) for a in (0, 1)], axis=0)
-    clear = lit_around & (np.minimum(frac, 1 - frac) > half)
-    assert clear.sum() > 200
+    # a camera pixel whose footprint straddles a projector column edge (or a shadow or depth edge)
+    # sees two codes and may read either; where its four corners see lit points of its own column
+    # (clear_column) the decode reads exactly that column's Gray code
+    clear = t.clear_column
+    assert clear.sum() > 200 and (clear <= t.lit).all() and (t.lit & ~clear).sum() > 50
     assert np.array_equal(gray[clear], t.gray_column[clear]), np.flatnonzero(gray[clear] != t.gray_column[clear])
+    # clear pixels lie away from their column's edges by at least the footprint's reach there
+    u = t.uv[..., 0]
+    frac = u + 0.5 - np.floor(u + 0.5)
+    assert np.nanmin(np.minimum(frac, 1 - frac)[clear]) > 0.01
     assert np.array_equal(t.gray_column[t.lit], t.column[t.lit] ^ (t.column[t.lit] >> 1))
-    assert (t.column[~t.lit] == -1).all() and (t.gray_row[~t.lit] == -1).all()
+    assert (t.column[~t.lit] == -1).all() and (t.gray_row[~t.lit] == -1).all() and not t.clear_row[~t.lit].any()

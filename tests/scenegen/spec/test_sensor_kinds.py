@@ -113,7 +113,7 @@ def test_every_camera_member_form_is_the_spec_it_always_was(tmp_path, member):
 
 
 @pytest.mark.parametrize("text,line,message", [
-    (MULTI % "{kind: clock, sensor: cam}", 4, "expected one of 'camera', 'imu' (sensor kind), got 'clock'"),
+    (MULTI % "{kind: clock, sensor: cam}", 4, "expected one of 'camera', 'imu', 'projector' (sensor kind), got 'clock'"),
     ("clocks: {clk0: {}}\n" + MULTI % "{camera: cam}", 1, "unknown key 'clocks'"),
     (MULTI % "{camera: cam, time_offset_s: 0.01}", 4,
      "a camera member samples at its rig's time (time_offset_s 0); got 0.01 s"),
@@ -165,5 +165,5 @@ def test_a_kind_declares_a_writer_exactly_when_it_writes_a_stream():
 def test_every_kind_has_a_section_of_its_own(clock):
     sections = [k.section for k in SENSOR_KINDS.values()]
     assert len(set(sections)) == len(sections)
-    assert [k.section for k in SENSOR_KINDS.values() if k.spec_field is None] == ["imus", "clocks"]
+    assert [k.section for k in SENSOR_KINDS.values() if k.spec_field is None] == ["imus", "projectors", "clocks"]
     assert all(k.section not in TOP_LEVEL_KEYS for k in SENSOR_KINDS.values() if k.spec_field is None)
