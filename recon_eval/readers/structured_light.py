@@ -64,6 +64,7 @@ class ProjectorView:
     truth_uv: np.ndarray  # (H, W, 2) float64 continuous projector pixel of each camera pixel (NaN: none)
     truth_code: np.ndarray  # (H, W, 2) int64 projector column, row a perfect decoder reads (-1: not lit)
     lit: np.ndarray  # (H, W) bool: the projector lights the camera pixel's point
+    clear: np.ndarray  # (H, W, 2) bool: lit, the pixel's footprint in one projector column (row)
     depth_z: np.ndarray  # (H, W) float64 metres, NaN on misses
     points_world: np.ndarray  # (H, W, 3) float64 metres, NaN on misses
     frame_index: int  # the view's frame of a sequence (0 without one)
@@ -124,6 +125,7 @@ def _read_view(ds: Dataset, view: str, source: str) -> ProjectorView:
     depth = ds.depth_z(view).astype(np.float64)
     return ProjectorView(view, camera, cam_from_world, projector, projector_from_world, tuple(frames),
                          np.stack(images), t.uv, np.stack([t.column, t.row], axis=2).astype(np.int64), t.lit,
+                         np.stack([t.clear_column, t.clear_row], axis=2),
                          np.where(np.isfinite(depth), depth, np.nan), ds.points_world(view).astype(np.float64),
                          int(ds.view_info(view).get("frame_index") or 0))
 

@@ -107,7 +107,8 @@ def score_view(pv: ProjectorView, codes: np.ndarray, points_world: np.ndarray, b
     """The results of one view (module docstring)."""
     axes = [a for a in (0, 1) if np.isfinite(codes[..., a]).any()] or [0]
     lengths = [(pv.projector.width, pv.projector.height)[a] for a in axes]
-    res = {"codes": code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit, lengths_px=lengths)}
+    res = {"codes": code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit, lengths_px=lengths,
+                                clear=pv.clear[..., axes])}
     if continuous:
         res["codes_vs_coordinates"] = code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit,
                                                   lengths_px=lengths, truth_px=pv.truth_uv[..., axes])
@@ -126,7 +127,8 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
         raise ValueError(f"triangulation must be one of {TRIANGULATIONS}, got {triangulation!r}")
     tau_m = float(options.get("tau_m", 0.001))
     views = projector_views(ds.root, source=str(options.get("source", "png")))
-    results, metrics, raw, fscores, pooled = {}, {}, [], [], {"dec": [], "code": [], "lit": [], "depth": [], "gt": [], "bound": []}
+    results, metrics, raw, fscores = {}, {}, [], []
+    pooled = {"dec": [], "code": [], "lit": [], "clear": [], "depth": [], "gt": [], "bound": []}
     for pv in views:
         codes = decode(pv)
         pts, bound = triangulate_view(pv, codes, triangulation)
@@ -140,17 +142,18 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
         r = score_view(pv, back_codes, back, bound, tau_m, continuous)
         results.update({f"{pv.view}.{k}": v for k, v in r.items()})
         fscores.append(r["cloud"].fscore)
-        for key, val in (("dec", back_codes), ("code", pv.truth_code), ("lit", pv.lit),
+        for key, val in (("dec", back_codes), ("code", pv.truth_code), ("lit", pv.lit), ("clear", pv.clear),
                          ("depth", pv.cam_from_world.apply(back)[..., 2]), ("gt", pv.depth_z), ("bound", bound)):
             pooled[key].append(val.reshape(-1, *val.shape[2:]))
     cat = {k: np.concatenate(v)[:, None] for k, v in pooled.items()}  # (N, 1[, 2]): one image column
     axes = [a for a in (0, 1) if np.isfinite(cat["dec"][..., a]).any()] or [0]
     lengths = [(views[0].projector.width, views[0].projector.height)[a] for a in axes]
     results["all.codes"] = code_errors(cat["dec"][..., axes], cat["code"][..., axes], cat["lit"],
-                                       lengths_px=lengths)
+                                       lengths_px=lengths, clear=cat["clear"][..., axes])
     results["all.depth"] = depth_errors(cat["depth"], cat["gt"], cat["lit"], bound_m=cat["bound"])
     c, d = results["all.codes"], results["all.depth"]
     metrics.update({"code_agreement": c.agreement, "code_agreement_decoded": c.agreement_decoded,
+                    "code_agreement_clear": c.agreement_clear,
                     "code_completeness": c.completeness, "code_err_mean_px": c.mean_px,
                     "depth_mean_abs_mm": 1e3 * d.mean_abs_m, "depth_rms_mm": 1e3 * d.rms_m,
                     "depth_p95_mm": 1e3 * d.p95_abs_m, "depth_within_bound": d.within_bound_frac,

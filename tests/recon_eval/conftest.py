@@ -520,7 +520,7 @@ def write_sl_dataset(root, pc: ProCam) -> None:
     extra[projector_truth_path("scan_0000")] = encode_projector_truth(ProjectorTruth(
         np.where(pc.lit[..., None], pc.uv, np.nan), pc.lit, lit_code[..., 0], lit_code[..., 1],
         np.where(pc.lit, binary_to_gray(lit_code[..., 0]), -1).astype(np.int32),
-        np.where(pc.lit, binary_to_gray(lit_code[..., 1]), -1).astype(np.int32)))
+        np.where(pc.lit, binary_to_gray(lit_code[..., 1]), -1).astype(np.int32), pc.lit, pc.lit))  # point-sampled: clear
     w.write_view("scan_0000", image=srgb(0), linear_rgb=rgb(0), truth=truth, extra_files=extra)
     w.close()
 
