@@ -45,7 +45,7 @@ def score(a):
     n = codes.shape[2]
     lengths = (pv.projector.width, pv.projector.height)[:n]
     res = {"codes": code_errors(codes, pv.truth_code[..., :n], pv.lit, lengths_px=lengths,
-                                truth_px=pv.truth_uv[..., :n] if a.continuous else None)}
+                                truth_px=pv.truth_uv[..., :n] if a.continuous else None, clear=pv.clear[..., :n])}
     if a.cloud:
         rec = read_geometry(a.cloud).vertices
         gt = pv.points_world[pv.lit & np.all(np.isfinite(pv.points_world), axis=2)]
@@ -56,14 +56,14 @@ def score(a):
 
 
 def metrics(a, res) -> dict:
-    """``metrics`` of ``codes --json``: the names an ``sl-*`` run gives the same numbers, per view."""
+    """``metrics`` of ``codes --json``: the names an ``sl-*`` run gives its pooled numbers (one
+    view here; ``fscore``: that view's, the run's ``fscore_mean`` over its views)."""
     c = res["codes"]
-    view = a.view or ""
-    pre = f"{view}." if view else ""
-    out = {f"{pre}code_agreement": c.agreement, f"{pre}code_agreement_decoded": c.agreement_decoded,
-           f"{pre}code_completeness": c.completeness, f"{pre}code_err_mean_px": c.mean_px}
+    out = {"code_agreement": c.agreement, "code_agreement_decoded": c.agreement_decoded,
+           "code_agreement_clear": c.agreement_clear,
+           "code_completeness": c.completeness, "code_err_mean_px": c.mean_px}
     if "cloud" in res:
-        out[f"{pre}fscore"] = res["cloud"].fscore
+        out["fscore"] = res["cloud"].fscore
     return out
 
 

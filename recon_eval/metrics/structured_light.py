@@ -7,7 +7,9 @@ reconstruction's depth against the truth depth.
   disagree), ``completeness`` = the fraction decoded; the code error ``|decoded - truth|`` in
   projector pixels (Euclidean over the axes) over the decoded lit pixels, against the truth codes
   (integers) or, when given, the continuous truth coordinates; ``false_decode_frac`` = decoded
-  pixels the projector does not light (shadows, the background), over all decoded pixels.
+  pixels the projector does not light (shadows, the background), over all decoded pixels;
+  ``agreement_clear``: the agreement over the lit pixels whose footprint lies in one projector
+  pixel (truth ``clear_column`` / ``clear_row``), where a code is unambiguous.
 * :func:`depth_errors`: ``|z_est - z_truth|`` (metres, z along the camera axis) over pixels with
   both, completeness over the truth-valid pixels, and, with a per-pixel bound (the pattern's
   quantisation, :func:`recon_eval.estimators.structured_light.triangulate.column_quantisation_bound`
@@ -40,6 +42,8 @@ class CodeResult:
     max_px: float
     false_decode_frac: float  # decoded but not lit / decoded
     against: str  # 'codes' (integer truth) or 'coordinates' (continuous truth)
+    n_clear: int = 0  # lit pixels whose footprint lies in one projector pixel on every axis (truth)
+    agreement_clear: float = math.nan  # agreement over those (undecoded disagree); NaN without a clear mask
 
 
 def _stats(e: np.ndarray) -> tuple[float, float, float, float, float]:
@@ -49,10 +53,12 @@ def _stats(e: np.ndarray) -> tuple[float, float, float, float, float]:
             float(np.percentile(e, 95)), float(np.max(e)))
 
 
-def code_errors(decoded_px, truth_code, lit, *, lengths_px, truth_px=None) -> CodeResult:
+def code_errors(decoded_px, truth_code, lit, *, lengths_px, truth_px=None, clear=None) -> CodeResult:
     """Score ``decoded_px`` (H, W, A) float projector coordinates (NaN where undecoded) against
     ``truth_code`` (H, W, A) int projector pixels, ``lit`` (H, W) bool; ``lengths_px`` (A,) the
-    projector's extent along each axis; ``truth_px`` (H, W, A) optional continuous truth."""
+    projector's extent along each axis; ``truth_px`` (H, W, A) optional continuous truth;
+    ``clear`` (H, W, A) optional bool: the pixel's footprint lies in one projector pixel along the
+    axis (its code is unambiguous), for ``agreement_clear``."""
     dec = np.asarray(decoded_px, dtype=np.float64)
     code = np.asarray(truth_code)
     lit = np.asarray(lit, dtype=bool)
@@ -68,10 +74,15 @@ def code_errors(decoded_px, truth_code, lit, *, lengths_px, truth_px=None) -> Co
     n_lit, n_dec = int(lit.sum()), int(scored.sum())
     n_all = int(decoded.sum())
     n_agree = int(agree.sum())
+    n_clear, agreement_clear = 0, math.nan
+    if clear is not None:
+        cl = lit & np.all(np.asarray(clear, dtype=bool), axis=2)
+        n_clear = int(cl.sum())
+        agreement_clear = int((agree & cl).sum()) / n_clear if n_clear else math.nan
     return CodeResult(n_lit, n_dec, n_dec / n_lit if n_lit else math.nan, n_agree / n_lit if n_lit else math.nan,
                       n_agree / n_dec if n_dec else math.nan,
                       *_stats(err), int((decoded & ~lit).sum()) / n_all if n_all else math.nan,
-                      "codes" if truth_px is None else "coordinates")
+                      "codes" if truth_px is None else "coordinates", n_clear, agreement_clear)
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,8 @@ SOURCES = ("png", "linear")
 
 @dataclass(frozen=True)
 class PatternFrame:
-    """What one stored pattern codes: ``kind`` white / black / gray / phase / other."""
+    """What one stored pattern codes: ``kind`` white / black / gray / binary / phase / other (the
+    file's ``kind`` where it gives one; an entry with an axis and a bit and no kind is Gray)."""
 
     kind: str
     axis: str = ""  # "u" or "v"
@@ -63,6 +64,7 @@ class ProjectorView:
     truth_uv: np.ndarray  # (H, W, 2) float64 continuous projector pixel of each camera pixel (NaN: none)
     truth_code: np.ndarray  # (H, W, 2) int64 projector column, row a perfect decoder reads (-1: not lit)
     lit: np.ndarray  # (H, W) bool: the projector lights the camera pixel's point
+    clear: np.ndarray  # (H, W, 2) bool: lit, the pixel's footprint in one projector column (row)
     depth_z: np.ndarray  # (H, W) float64 metres, NaN on misses
     points_world: np.ndarray  # (H, W, 3) float64 metres, NaN on misses
     frame_index: int  # the view's frame of a sequence (0 without one)
@@ -77,8 +79,9 @@ def _frame(entry: dict, projector: Camera, source: str) -> PatternFrame:
             return PatternFrame("phase", axis, period_px=float(entry["period_px"]), step=int(entry["step"]),
                                 shift_rad=float(entry["shift_rad"]))
         if axis and int(entry.get("bit", -1)) >= 0:
-            n = bits_for(projector.width if axis == "u" else projector.height)
-            return PatternFrame("gray", axis, n - 1 - int(entry["bit"]), n, bool(entry.get("inverse", False)))
+            kind = "binary" if entry.get("kind") == "binary" else "gray"
+            n = int(entry.get("n_bits") or bits_for(projector.width if axis == "u" else projector.height))
+            return PatternFrame(kind, axis, n - 1 - int(entry["bit"]), n, bool(entry.get("inverse", False)))
     except (KeyError, TypeError, ValueError) as e:
         raise InputError(f"{source}: pattern {entry.get('index')}: unreadable entry ({e})") from None
     return PatternFrame("other", axis)
@@ -106,15 +109,23 @@ def _read_view(ds: Dataset, view: str, source: str) -> ProjectorView:
             raise InputError(f"{where}: a pattern entry without an 'image' path")
         frames.append(_frame(entry, projector, where))
         if source == "linear":
+            if not isinstance(entry.get("linear"), str):
+                raise InputError(f"{where}: pattern {entry.get('index')}: no linear render ('linear'); "
+                                 f"read the images instead")
             lin = ds.read(entry["linear"], lambda p: unpack_channels(read_exr(p), "", LINEAR_CHANNELS), "pattern")
             images.append(np.asarray(lin, np.float64).mean(axis=2))
         else:
             images.append(_grey(ds.read(entry["image"], read_png, "pattern image")))
     t = ds.read(projector_truth_path(view), lambda p: decode_projector_truth(p.read_bytes()), "projector truth")
     camera, cam_from_world = ds.camera(view)
+    for entry, img in zip(doc["patterns"], images):
+        if img.shape != (camera.height, camera.width) or t.lit.shape != img.shape:
+            raise InputError(f"{ds.path(entry['image'])}: a {img.shape} image (projector truth {t.lit.shape}); "
+                             f"the view's camera is {camera.height} x {camera.width}")
     depth = ds.depth_z(view).astype(np.float64)
     return ProjectorView(view, camera, cam_from_world, projector, projector_from_world, tuple(frames),
                          np.stack(images), t.uv, np.stack([t.column, t.row], axis=2).astype(np.int64), t.lit,
+                         np.stack([t.clear_column, t.clear_row], axis=2),
                          np.where(np.isfinite(depth), depth, np.nan), ds.points_world(view).astype(np.float64),
                          int(ds.view_info(view).get("frame_index") or 0))
 

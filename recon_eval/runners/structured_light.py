@@ -11,7 +11,8 @@
 * ``phase``: N-step phase at each period, hierarchical temporal unwrapping
   (:mod:`recon_eval.estimators.structured_light.phase`), the ray against the continuous column.
 
-Scores per view and pooled over views (:mod:`recon_eval.metrics.structured_light`): code
+Scores per view (``results``) and pooled over the views (``metrics``; the views' mean F-score
+``fscore_mean``) (:mod:`recon_eval.metrics.structured_light`): code
 agreement with the truth codes over the lit pixels, code error (projector px), completeness;
 depth error against the truth depth and the fraction within each pixel's quantisation bound
 (half a projector column along the ray); Tanks and Temples F-score at ``tau_m`` and Chamfer
@@ -45,23 +46,26 @@ def _frames(pv: ProjectorView, kind: str) -> list[int]:
 
 
 def decode_gray_view(pv: ProjectorView, threshold: float, min_contrast: float) -> np.ndarray:
-    """(H, W, 2) float64 decoded (column, row), NaN where none (an axis not coded: NaN)."""
+    """(H, W, 2) float64 decoded (column, row), NaN where none (an axis not coded: NaN); Gray or
+    plain binary code words, as the frames say."""
     white, black = (_frames(pv, k) for k in ("white", "black"))
     if not white or not black:
         raise NotApplicable(f"view {pv.view!r}: the Gray-code decoder needs the white and black frames")
     w, b = pv.images[white[0]], pv.images[black[0]]
     mask = contrast_mask(w, b, min_contrast)
     out = np.full(w.shape + (2,), np.nan)
+    coded = [f.kind for f in pv.frames if f.kind in ("gray", "binary")]
+    kind = coded[0] if coded else "gray"
     for a, axis in enumerate(("u", "v")):
-        bits = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == "gray" and f.axis == axis and not f.inverse)
-        inv = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == "gray" and f.axis == axis and f.inverse)
+        bits = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == kind and f.axis == axis and not f.inverse)
+        inv = sorted((f.bit, i) for i, f in enumerate(pv.frames) if f.kind == kind and f.axis == axis and f.inverse)
         if not bits:
             continue
         if [x for x, _ in bits] != [x for x, _ in inv]:
             raise NotApplicable(f"view {pv.view!r}: axis {axis}: every bit needs its inverse")
         length = pv.projector.width if axis == "u" else pv.projector.height
         d = decode_axis(pv.images[[i for _, i in bits]], pv.images[[i for _, i in inv]], length_px=length,
-                        threshold=threshold * (w - b), mask=mask)
+                        threshold=threshold * (w - b), gray=kind == "gray", mask=mask)
         out[..., a] = np.where(d.code >= 0, d.code, np.nan)
     return out
 
@@ -103,7 +107,8 @@ def score_view(pv: ProjectorView, codes: np.ndarray, points_world: np.ndarray, b
     """The results of one view (module docstring)."""
     axes = [a for a in (0, 1) if np.isfinite(codes[..., a]).any()] or [0]
     lengths = [(pv.projector.width, pv.projector.height)[a] for a in axes]
-    res = {"codes": code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit, lengths_px=lengths)}
+    res = {"codes": code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit, lengths_px=lengths,
+                                clear=pv.clear[..., axes])}
     if continuous:
         res["codes_vs_coordinates"] = code_errors(codes[..., axes], pv.truth_code[..., axes], pv.lit,
                                                   lengths_px=lengths, truth_px=pv.truth_uv[..., axes])
@@ -116,21 +121,14 @@ def score_view(pv: ProjectorView, codes: np.ndarray, points_world: np.ndarray, b
     return res
 
 
-def _headline(res: dict, prefix: str) -> dict:
-    c, d, t = res["codes"], res["depth"], res["cloud"]
-    return {f"{prefix}code_agreement": c.agreement, f"{prefix}code_agreement_decoded": c.agreement_decoded,
-            f"{prefix}code_completeness": c.completeness, f"{prefix}code_err_mean_px": c.mean_px,
-            f"{prefix}depth_mean_abs_mm": 1e3 * d.mean_abs_m, f"{prefix}depth_rms_mm": 1e3 * d.rms_m,
-            f"{prefix}depth_within_bound": d.within_bound_frac, f"{prefix}fscore": t.fscore}
-
-
 def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
     triangulation = str(options.get("triangulation", "plane"))
     if triangulation not in TRIANGULATIONS:
         raise ValueError(f"triangulation must be one of {TRIANGULATIONS}, got {triangulation!r}")
     tau_m = float(options.get("tau_m", 0.001))
     views = projector_views(ds.root, source=str(options.get("source", "png")))
-    results, metrics, raw, pooled = {}, {}, [], {"dec": [], "code": [], "lit": [], "depth": [], "gt": [], "bound": []}
+    results, metrics, raw, fscores = {}, {}, [], []
+    pooled = {"dec": [], "code": [], "lit": [], "clear": [], "depth": [], "gt": [], "bound": []}
     for pv in views:
         codes = decode(pv)
         pts, bound = triangulate_view(pv, codes, triangulation)
@@ -143,21 +141,23 @@ def _run(ds, out_dir, options, decode, continuous: bool) -> RunOutput:
         back[ok] = read_geometry(out_path(out_dir, f"{pv.view}/cloud.ply")).vertices
         r = score_view(pv, back_codes, back, bound, tau_m, continuous)
         results.update({f"{pv.view}.{k}": v for k, v in r.items()})
-        metrics.update(_headline(r, f"{pv.view}."))
-        for key, val in (("dec", back_codes), ("code", pv.truth_code), ("lit", pv.lit),
+        fscores.append(r["cloud"].fscore)
+        for key, val in (("dec", back_codes), ("code", pv.truth_code), ("lit", pv.lit), ("clear", pv.clear),
                          ("depth", pv.cam_from_world.apply(back)[..., 2]), ("gt", pv.depth_z), ("bound", bound)):
             pooled[key].append(val.reshape(-1, *val.shape[2:]))
     cat = {k: np.concatenate(v)[:, None] for k, v in pooled.items()}  # (N, 1[, 2]): one image column
     axes = [a for a in (0, 1) if np.isfinite(cat["dec"][..., a]).any()] or [0]
     lengths = [(views[0].projector.width, views[0].projector.height)[a] for a in axes]
     results["all.codes"] = code_errors(cat["dec"][..., axes], cat["code"][..., axes], cat["lit"],
-                                       lengths_px=lengths)
+                                       lengths_px=lengths, clear=cat["clear"][..., axes])
     results["all.depth"] = depth_errors(cat["depth"], cat["gt"], cat["lit"], bound_m=cat["bound"])
     c, d = results["all.codes"], results["all.depth"]
     metrics.update({"code_agreement": c.agreement, "code_agreement_decoded": c.agreement_decoded,
+                    "code_agreement_clear": c.agreement_clear,
                     "code_completeness": c.completeness, "code_err_mean_px": c.mean_px,
                     "depth_mean_abs_mm": 1e3 * d.mean_abs_m, "depth_rms_mm": 1e3 * d.rms_m,
-                    "depth_p95_mm": 1e3 * d.p95_abs_m, "depth_within_bound": d.within_bound_frac})
+                    "depth_p95_mm": 1e3 * d.p95_abs_m, "depth_within_bound": d.within_bound_frac,
+                    "fscore_mean": float(np.mean(fscores))})
     notes = {"views": [pv.view for pv in views], "triangulation": triangulation, "tau_m": tau_m,
              "options": dict(options)}
     return RunOutput(results, metrics, raw, notes)

@@ -42,6 +42,8 @@ def _moving_object(ds) -> str:
 def run(ds, out_dir, options) -> RunOutput:
     tau_m = float(options.get("tau_m", 0.001))
     margin = float(options.get("crop_margin_m", 0.002))
+    if ds.read(lambda: ds.dataset.sequence.index) is None:
+        raise NotApplicable(f"{ds.root}: not a sequence (a turntable scan needs the object's pose per step)")
     name = str(options.get("object") or _moving_object(ds))
     views = projector_views(ds.root, source=str(options.get("source", "png")))
     seq = ds.dataset.sequence

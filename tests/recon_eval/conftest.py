@@ -22,6 +22,8 @@ ray-cast states call those pixels occluded, a depth test at the nearest pixel ce
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import types
 
 import numpy as np
@@ -36,6 +38,14 @@ from scenegen.dataset.crossview import encode_correspondence_channels
 from scenegen.dataset.layout import correspondence_path
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3, look_at
+from scenegen.dataset.codecs import encode_json, encode_png
+from scenegen.dataset.codecs.exr import pack_channels
+from scenegen.dataset.layout import pattern_image_path, pattern_linear_path, pattern_sequence_path, projector_truth_path
+from scenegen.dataset.structured_light import PATTERNS_FORMAT, ProjectorTruth, encode_projector_truth
+from scenegen.dataset.truth import LINEAR_CHANNELS
+from scenegen.geometry.color import srgb_from_linear
+from scenegen.geometry.conventions import pixel_centers
+from scenegen.imaging.patterns import binary_to_gray, gray_code, perfect_code, sample
 
 W, H = 40, 30
 BASELINE_M = 0.5
@@ -393,3 +403,130 @@ def _two_view_points(n: int = 100, seed: int = 0):
 def two_view_points():
     """``two_view_points(n=100, seed=0) -> (x1, x2, F_gt, K, cam2_from_cam1)``: exact correspondences."""
     return _two_view_points
+
+
+# --- structured light ----------------------------------------------------------------------------
+# An analytic projector-camera scene (a tilted plane and a sphere in front of it): every camera
+# pixel centre's ray hit in closed form, its projector coordinate by the projector's own model,
+# the pattern sampled there (scenegen.imaging.patterns.sample); and the same scene written as a
+# dataset with projector-lit views (docs/dataset_format.md, "Structured light") for the runners.
+SL_PLANE_N = np.array([0.15, -0.1, 1.0]) / np.linalg.norm([0.15, -0.1, 1.0])  # plane n . X = SL_PLANE_D
+SL_PLANE_D = 0.6
+SL_SPHERE_C = np.array([0.01, 0.0, 0.5])
+SL_SPHERE_R = 0.07
+
+
+@dataclass(frozen=True)
+class ProCam:
+    camera: Camera
+    cam_from_world: Rigid3
+    projector: Camera
+    proj_from_world: Rigid3
+    points: np.ndarray  # (H, W, 3) world points of the pixel centres (NaN: no hit)
+    uv: np.ndarray  # (H, W, 2) continuous projector coordinates of the points
+    lit: np.ndarray  # (H, W) bool: the projector lights the point
+    albedo: np.ndarray  # (H, W)
+
+    def observe(self, seq, *, noise_sigma: float = 0.0, ambient: float = 0.05, seed: int = 0) -> np.ndarray:
+        """(N, H, W) grey images of the sequence: albedo * (pattern where lit + ambient) + noise."""
+        vals = sample(seq, self.uv).astype(np.float64)  # (N, H, W)
+        img = self.albedo[None] * (np.where(self.lit[None], vals, 0.0) + ambient)
+        if noise_sigma:
+            img = img + np.random.default_rng(seed).normal(0.0, noise_sigma, img.shape)
+        return img
+
+
+def _sl_sphere_t(o, d):
+    """Nearest positive ray parameter of rays o + t d (unit d) on the sphere; inf where none."""
+    w = np.broadcast_to(o - SL_SPHERE_C, d.shape)
+    b = np.einsum("...i,...i->...", d, w)
+    disc = b * b - (np.einsum("...i,...i->...", w, w) - SL_SPHERE_R ** 2)
+    t = -b - np.sqrt(np.maximum(disc, 0.0))
+    return np.where((disc > 0) & (t > 1e-9), t, np.inf)
+
+
+def build_procam(camera: Camera, projector: Camera, proj_centre) -> ProCam:
+    cam_from_world = Rigid3.identity()
+    proj_from_world = look_at(proj_centre, [0.0, 0.0, 0.55], up=(0.0, -1.0, 0.0)).inverse()
+    H, W = camera.height, camera.width
+    d = camera.unproject_unit(pixel_centers(W, H).reshape(-1, 2))
+    o = np.zeros(3)
+    t_plane = SL_PLANE_D / (d @ SL_PLANE_N)
+    t_sph = _sl_sphere_t(o, d)
+    on_sphere = t_sph < t_plane
+    t = np.where(on_sphere, t_sph, t_plane)
+    p = d * t[:, None]
+    # projector visibility: the point's normal faces the projector; nothing (the sphere) between
+    pc = np.asarray(proj_centre, float)
+    normal = np.where(on_sphere[:, None], (p - SL_SPHERE_C) / SL_SPHERE_R, -SL_PLANE_N)
+    to_proj = pc - p
+    dist = np.linalg.norm(to_proj, axis=1)
+    dir_p = to_proj / dist[:, None]
+    blocked = ~on_sphere & (_sl_sphere_t(p + 1e-9 * dir_p, dir_p) < dist)
+    uv, ok = projector.project(proj_from_world.apply(p), return_valid=True)
+    inside = ok & (uv[:, 0] >= -0.5) & (uv[:, 0] < projector.width - 0.5) & (uv[:, 1] >= -0.5) & \
+        (uv[:, 1] < projector.height - 0.5)
+    lit = inside & (np.einsum("ij,ij->i", normal, dir_p) > 0) & ~blocked
+    albedo = np.where(on_sphere, 0.7, 0.5) + 0.2 * np.cos(40 * p[:, 0])  # textured, 0.3..0.9
+    return ProCam(camera, cam_from_world, projector, proj_from_world, p.reshape(H, W, 3), uv.reshape(H, W, 2),
+                  lit.reshape(H, W), albedo.reshape(H, W))
+
+
+@pytest.fixture(scope="session")
+def procam() -> ProCam:
+    """A 160 x 120 OpenCV camera with distortion, a 128 x 96 projector with distortion, skew and
+    an off-centre principal point, 0.15 m apart."""
+    camera = Camera("opencv", 160, 120, 150.0, 151.0, 80.3, 59.6, dist=(-0.05, 0.01, 0.001, -0.0005, 0.0))
+    projector = Camera("opencv", 128, 96, 140.0, 139.0, 60.0, 70.0, skew=0.4, dist=(0.04, -0.01, 0.0, 0.0, 0.0))
+    return build_procam(camera, projector, (0.15, -0.02, 0.0))
+
+
+def write_sl_dataset(root, pc: ProCam) -> None:
+    """One projector-lit view ``scan_0000`` of the analytic scene under the Gray-code sequence,
+    in the layout the renderer writes (PNG and linear EXR per pattern, sequence.json, projector truth)."""
+    seq = gray_code(pc.projector.width, pc.projector.height)
+    H, W = pc.camera.height, pc.camera.width
+    w = ds.DatasetWriter(root, spec_sha256="5c" * 32, seed=1, variant="test", versions={"numpy": "x"})
+    w.write_cameras({"scan_0000": ds.ViewCamera(pc.camera, pc.cam_from_world, "cam", frame_index=0)},
+                    {"objects": [{"name": "plane"}, {"name": "sphere"}]})
+    P = pc.points
+    Pc = pc.cam_from_world.apply(P)
+    n = np.where(np.linalg.norm(P - SL_SPHERE_C, axis=2, keepdims=True) < SL_SPHERE_R + 1e-9,
+                 (P - SL_SPHERE_C) / SL_SPHERE_R, -SL_PLANE_N)
+    f32 = lambda a: np.asarray(a, np.float32)  # noqa: E731
+    truth = {"depth_z": f32(Pc[..., 2]), "range": f32(np.linalg.norm(Pc, axis=2)), "points_world": f32(P),
+             "points_cam": f32(Pc), "normals_world": f32(n), "normals_cam": f32(n), "uv": np.zeros((H, W, 2), np.float32),
+             "object_id": np.ones((H, W), np.uint32), "instance_id": np.ones((H, W), np.uint32),
+             "valid": np.ones((H, W), bool)}
+    images = pc.observe(seq)  # (N, H, W) linear
+    rgb = lambda k: np.repeat(images[k][..., None], 3, axis=2).astype(np.float32)  # noqa: E731
+    srgb = lambda k: np.round(255 * srgb_from_linear(rgb(k))).astype(np.uint8)  # noqa: E731
+    entries, extra = [], {}
+    for k, fr in enumerate(seq.frames):
+        axis = {"u": "columns", "v": "rows"}.get(fr.axis, "")
+        bit = fr.n_bits - 1 - fr.bit if fr.bit >= 0 else -1  # the file counts from the least significant bit
+        extra[pattern_image_path("scan_0000", k)] = encode_png(srgb(k))
+        extra[pattern_linear_path("scan_0000", k)] = encode_exr(pack_channels("", rgb(k), LINEAR_CHANNELS))
+        entries.append({"index": k, "name": fr.kind if fr.kind in ("white", "black") else f"{axis[:3]}_bit{bit:02d}",
+                        "axis": axis, "bit": bit, "inverse": fr.inverse, "image": pattern_image_path("scan_0000", k),
+                        "linear": pattern_linear_path("scan_0000", k)})
+    doc = {"format": PATTERNS_FORMAT, "view": "scan_0000",
+           "projector": {"name": "proj", "camera": pc.projector.to_dict(),
+                         "projector_from_world": pc.proj_from_world.matrix.tolist()},
+           "patterns": entries}
+    extra[pattern_sequence_path("scan_0000")] = encode_json(doc)
+    code = perfect_code(seq, pc.uv)
+    lit_code = np.where(pc.lit[..., None], code, -1).astype(np.int32)
+    extra[projector_truth_path("scan_0000")] = encode_projector_truth(ProjectorTruth(
+        np.where(pc.lit[..., None], pc.uv, np.nan), pc.lit, lit_code[..., 0], lit_code[..., 1],
+        np.where(pc.lit, binary_to_gray(lit_code[..., 0]), -1).astype(np.int32),
+        np.where(pc.lit, binary_to_gray(lit_code[..., 1]), -1).astype(np.int32), pc.lit, pc.lit))  # point-sampled: clear
+    w.write_view("scan_0000", image=srgb(0), linear_rgb=rgb(0), truth=truth, extra_files=extra)
+    w.close()
+
+
+@pytest.fixture(scope="session")
+def sl_dataset(tmp_path_factory, procam):
+    root = tmp_path_factory.mktemp("sl") / "scan"
+    write_sl_dataset(root, procam)
+    return root

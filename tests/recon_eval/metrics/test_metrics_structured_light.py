@@ -14,6 +14,11 @@ def test_code_errors_by_hand():
     assert (r.n_lit, r.n_decoded) == (3, 2)
     assert math.isclose(r.completeness, 2 / 3) and math.isclose(r.agreement, 1 / 3)  # 6.2 names pixel 6
     assert math.isclose(r.max_px, 1.2) and math.isclose(r.mean_px, 0.6) and math.isclose(r.false_decode_frac, 1 / 3)
+    assert r.n_clear == 0 and math.isnan(r.agreement_clear)
+    clear = np.ones((2, 2, 2), bool)
+    clear[1, 0, 1] = False  # the wrong pixel straddles a row edge: not scored by agreement_clear
+    rc = code_errors(dec, truth, lit, lengths_px=(8, 4), clear=clear)
+    assert rc.n_clear == 2 and math.isclose(rc.agreement_clear, 0.5)  # one clear pixel undecoded
     cont = code_errors(dec, truth, lit, lengths_px=(8, 4), truth_px=truth + 0.25)
     assert cont.against == "coordinates" and math.isclose(cont.max_px, math.hypot(0.95, 0.25))
 
