@@ -54,7 +54,8 @@ class Method:
 
 #: The task of each runner function ((module, function); (module, None): every function of the
 #: module): methods of one task share a leaderboard table, one column per metric.
-TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo disparity", ("active_stereo", None): "active IR stereo",
+TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo disparity",
+         ("active_stereo", None): "active IR stereo",
          ("twoview", "fundamental"): "fundamental matrix", ("twoview", "essential"): "essential matrix",
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.crossview import NO_SURFACE as STATE_NONE, OCCLUDED as STATE_OCC, OUT_OF_FRAME, VISIBLE
 from scenegen.dataset.ir_stereo import (NO_SURFACE, OCCLUDED, OUT_OF_RANGE, SHADOW, decode_invalid,
                                         encode_invalid, invalid_mask)
-from scenegen.dataset.codecs.png import encode_png
 from scenegen.errors import SpecError
 from scenegen.spec import parse_spec, spec_sha256, to_yaml
 

@@ -5,10 +5,13 @@ an independent computation (trimesh casts toward the projector and toward the ri
 stated depth range); SGBM on the IR pair runs end to end and scores better with the dots on."""
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 import trimesh
 
+from recon_eval.errors import NotApplicable
 from recon_eval.runners import run_method
 from scenegen.dataset import Dataset, verify
 from scenegen.dataset.ir_stereo import NO_SURFACE, OCCLUDED, OUT_OF_RANGE, SHADOW
@@ -156,4 +159,13 @@ def test_sgbm_on_the_ir_pair_end_to_end(rendered):
     assert 0 < on["valid_px_pct"] == off["valid_px_pct"] < 100
     assert (root / "opencv-sgbm-ir" / "disparity").is_dir()
     print({k: (on[k], off[k]) for k in ("bad_2_0_valid_pct", "invalid_valid_pct", "bad_2_0_noc_pct")})
-    assert on["invalid_valid_pct"] < off["invalid_valid_pct"]  # the dots give the matcher texture
+    # the dots give the matcher texture: more estimates, fewer wrong ones
+    assert on["invalid_valid_pct"] < off["invalid_valid_pct"] and on["bad_2_0_valid_pct"] < off["bad_2_0_valid_pct"]
+
+
+def test_a_passive_stereo_frame_is_not_applicable(rendered):
+    root, d, _ = rendered
+    passive = root / "passive"
+    shutil.copytree(d.root, passive, ignore=shutil.ignore_patterns("ir_*.png"))
+    with pytest.raises(NotApplicable, match="has no IR pair"):
+        run_method("opencv-sgbm-ir", passive, root / "passive_run")
