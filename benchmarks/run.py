@@ -13,7 +13,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 BENCHES = ("bench_render.py", "bench_frame.py", "bench_warm.py", "bench_startup.py", "bench_codecs.py", "bench_fscore.py",
-           "bench_mesh_distance.py", "bench_scale.py", "bench_flow.py", "bench_stages.py")
+           "bench_mesh_distance.py", "bench_scale.py", "bench_flow.py", "bench_stages.py",
+           "bench_structured_light.py")
 
 
 def run(script: str, targets: list[str]) -> int:

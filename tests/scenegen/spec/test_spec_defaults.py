@@ -25,6 +25,7 @@ from scenegen.spec.model.meta import META_KEY, NOT_GIVEN, field_info, spec_field
 from scenegen.spec.parse.read import read_float
 from scenegen.spec.sensors import SENSOR_KINDS
 from scenegen.spec.sensors.imu import ImuSpec
+from scenegen.spec.sensors.projector import ProjectorSpec
 
 sys.path.insert(0, str(Path(__file__).parent))
 from clock_sensor import CLOCK  # noqa: E402  (a test-only sensor kind: a second kind to switch to)
@@ -197,6 +198,13 @@ CASES += [
      lambda s: s.rigs["r"].members[0].time_offset_s, 0.25),
     (ImuSpec, "rate_hz", "imus:\n  imu0: {}\n", lambda s: s.sensors["imu"]["imu0"].rate_hz, 100.0),
 ]
+#: A projector of fixed defaults (its intrinsics required).
+PROJ = "projectors:\n  p: {intrinsics: {size: [16, 8], fx: 20}%s}\n"
+CASES += [(ProjectorSpec, k, PROJ % "", lambda s, k=k: getattr(s.sensors["projector"]["p"], k), v)
+          for k, v in (("intensity_w_sr", (2.0, 2.0, 2.0)), ("gamma", 2.2), ("black_level", 0.05), ("falloff", "cos4"),
+                       ("patterns", "binary"), ("pattern_axes", "rows"), ("pattern_inverse", False),
+                       ("pattern_white_black", False), ("phase_steps", 8), ("stripe_px", 2), ("dots_density", 0.5),
+                       ("dot_px", 2), ("linear_patterns", True))]
 IDS = [f"{c[0].__name__}.{c[1]}" for c in CASES]
 
 
