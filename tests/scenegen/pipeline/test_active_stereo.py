@@ -17,6 +17,7 @@ from scenegen.dataset import Dataset, verify
 from scenegen.dataset.ir_stereo import NO_SURFACE, OCCLUDED, OUT_OF_RANGE, SHADOW
 from scenegen.geometry.camera import Camera
 from scenegen.geometry.pose import Rigid3
+from scenegen.imaging import patterns
 from scenegen.pipeline.run import render_spec
 
 pytestmark = pytest.mark.render
@@ -150,6 +151,28 @@ def test_invalid_mask_bits_equal_an_independent_computation(rendered, cast):
         got = (bits[idx] & bit) > 0
         assert 20 < expected.sum() < len(idx) - 20, bit  # the scene exercises the category both ways
         assert np.array_equal(got, expected), (bit, np.flatnonzero(got != expected))
+
+
+def test_the_ir_image_shows_the_dots_where_the_truth_puts_them(rendered, cast):
+    """The dot each lit pixel's (trimesh) surface point receives, by projecting it through the
+    projector, is what the rendered IR pair shows there: the image and the truth agree on the
+    projector's pose and pattern."""
+    _, d, frame = rendered
+    _, z, P, _ = cast
+    seq = d.pattern_sequence(frame.left_view)
+    proj = Camera.from_dict(seq["projector"]["camera"])
+    proj_from_world = Rigid3.from_matrix(np.array(seq["projector"]["projector_from_world"]))
+    e = seq["patterns"][0]
+    dots = patterns.random_dots(proj.width, proj.height, seed=e["seed"], density=e["density"], dot_px=e["dot_px"])
+    ok = np.isfinite(z).ravel()
+    uv = np.full((len(P), 2), np.nan)
+    uv[ok] = proj.project(proj_from_world.apply(P[ok]))
+    value = patterns.sample(dots, uv)[0]
+    lit = ok & ((frame.ir_invalid("left").ravel() & SHADOW) == 0)
+    ir = frame.ir_image("left").ravel().astype(float)
+    on, off = ir[lit & (value == 1)], ir[lit & (value == 0)]
+    assert len(on) > 300 and len(off) > 300
+    assert np.median(on) > np.median(off) + 20 and np.mean(on > np.median(off)) > 0.9, (np.median(on), np.median(off))
 
 
 def test_sgbm_on_the_ir_pair_end_to_end(rendered):
