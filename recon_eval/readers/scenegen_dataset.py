@@ -323,6 +323,15 @@ class DatasetTruth:
         """(H, W) bool: rectified pixels of one side with a surface the other side sees (KITTI noc)."""
         return self.read(self._stereo(left_view).disparity_kitti, side, "noc")[1]
 
+    def stereo_ir_images(self, left_view: str, projector: bool = True) -> tuple:
+        """(left, right) rectified monochrome IR images (H, W) of an active stereo frame."""
+        frame = self._stereo(left_view)
+        return self.read(frame.ir_image, "left", projector), self.read(frame.ir_image, "right", projector)
+
+    def stereo_ir_invalid(self, left_view: str, side: str = "left") -> np.ndarray:
+        """(H, W) uint8 active IR stereo invalid bits (0 = valid; scenegen.dataset.ir_stereo)."""
+        return self.read(self._stereo(left_view).ir_invalid, side)
+
     def _stereo(self, left_view: str):
         try:
             return self.dataset.crossview.stereo(left_view)

@@ -55,6 +55,7 @@ class Method:
 #: The task of each runner function ((module, function); (module, None): every function of the
 #: module): methods of one task share a leaderboard table, one column per metric.
 TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo disparity",
+         ("active_stereo", None): "active IR stereo",
          ("twoview", "fundamental"): "fundamental matrix", ("twoview", "essential"): "essential matrix",
          ("twoview", "homography"): "homography", ("pnp", None): "absolute pose (PnP)",
          ("colmap", None): "structure from motion", ("features", None): "keypoints and matches",
@@ -95,6 +96,11 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("opencv-calib-fisheye", "calibration", "fisheye", "cv2.fisheye.calibrate on checkerboard corners"),
     _m("opencv-stereo-bm", "stereo", "run", "cv2.StereoBM on the rectified pairs", matcher="bm"),
     _m("opencv-stereo-sgbm", "stereo", "run", "cv2.StereoSGBM (3-way) on the rectified pairs", matcher="sgbm"),
+    _m("opencv-sgbm-ir", "active_stereo", "run", "cv2.StereoSGBM (3-way) on the active IR pair, dot projector on",
+       projector="on", matcher="sgbm"),
+    _m("opencv-sgbm-ir-off", "active_stereo", "run",
+       "cv2.StereoSGBM (3-way) on the active IR pair with the projector off (ambient only)", projector="off",
+       matcher="sgbm"),
     *[_m(f"opencv-f-{f.replace('_', '-')}", "twoview", "fundamental", f"cv2.findFundamentalMat {f}", flag=f)
       for f in _F],
     *[_m(f"survey-f-{e.name}", "fsurvey", "fundamental", f"{e.label} ({e.cites}); numpy/scipy, Armangue and Salvi's "

@@ -34,6 +34,12 @@ from scenegen.geometry.color import to_grey8
 BLOCK = 5
 
 
+def sgbm_matcher(width: int, channels: int):
+    """StereoSGBM (module docstring's settings) for images ``width`` pixels wide, and its
+    numDisparities (also the active IR runner's, :mod:`recon_eval.runners.active_stereo`)."""
+    return _matcher("sgbm", width, channels)
+
+
 def _matcher(kind: str, width: int, channels: int):
     """The matcher for images ``width`` pixels wide with ``channels`` channels, and its
     numDisparities."""

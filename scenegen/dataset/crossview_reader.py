@@ -26,6 +26,7 @@ from scenegen.dataset.crossview import (
     decode_rectification_map,
 )
 from scenegen.dataset.errors import DatasetError
+from scenegen.dataset.ir_stereo import decode_invalid
 from scenegen.dataset.layout import (
     CAMERAS,
     CROSSVIEW_INDEX,
@@ -143,6 +144,16 @@ class StereoFrame:
     def object_ids(self, side: str) -> np.ndarray:
         """(H, W) uint32 object id of the surface each rectified pixel centre sees (0 = none)."""
         return self._read("ids", side, read_exr, "ids")[TruthKind.OBJECT_ID]
+
+    def ir_image(self, side: str, projector: bool = True) -> np.ndarray:
+        """(H, W) monochrome IR image of one side (active IR stereo, a rig with a projector), the
+        projector on or off (docs/dataset_format.md, "Active IR stereo")."""
+        key = "ir" if projector else "ir_off"
+        return self._read(key, side, read_png, f"IR image ({'projector on' if projector else 'projector off'})")
+
+    def ir_invalid(self, side: str) -> np.ndarray:
+        """(H, W) uint8 invalid bits of one side (:mod:`scenegen.dataset.ir_stereo`; 0 = valid)."""
+        return self._read("ir_invalid", side, lambda p: decode_invalid(p.read_bytes()), "IR invalid mask")
 
 
 class CrossviewTruth:

@@ -71,6 +71,8 @@ STEREO_FILES = {
     "image": "{side}.png", "linear": "{side}_linear.exr", "disparity_pfm": "disp_{side}.pfm",
     "disparity_occ": "disp_{side}_occ.png", "disparity_noc": "disp_{side}_noc.png",
     "correspondence": "corr_{side}.exr", "map": "map_{side}.exr", "ids": "ids_{side}.exr",
+    # active IR stereo (a rig with a projector, docs/dataset_format.md "Active IR stereo")
+    "ir": "ir_{side}.png", "ir_off": "ir_off_{side}.png", "ir_invalid": "ir_invalid_{side}.png",
 }
 STEREO_CALIB = "calib.json"
 STEREO_SIDES = ("left", "right")

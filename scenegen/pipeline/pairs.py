@@ -44,9 +44,17 @@ def select_pairs(mode, views) -> list[tuple[str, str]]:
 
 
 def stereo_frames(views, rigs) -> list[tuple[str, str]]:
-    """(left view, right view) of every frame of a stereo rig, in order."""
+    """(left view, right view) of every frame of a stereo rig, or of a multi rig whose members
+    ``left`` and ``right`` are cameras (active IR stereo: two cameras and a projector), in order."""
     frames: dict = {}
     for v in views:
-        if v.rig is not None and rigs[v.rig].type == "stereo":
+        if v.rig is not None and _stereo_like(rigs[v.rig]):
             frames.setdefault((v.view_set, v.frame_index), {})[v.rig_member] = v.name
     return [(f["left"], f["right"]) for f in frames.values() if "left" in f and "right" in f]
+
+
+def _stereo_like(rig) -> bool:
+    if rig.type == "stereo":
+        return True
+    cams = {mb.name for mb in rig.members if mb.kind == "camera"}
+    return {"left", "right"} <= cams

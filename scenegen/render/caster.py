@@ -66,6 +66,18 @@ class Caster:
         return render_ideal(self.device, sensor_camera_name, camera, cam_from_world, spp=spp, seed=seed,
                             light_scales=light_scales, time_s=time_s)
 
+    def render_ideal_pattern(self, sensor_camera_name: str, camera, cam_from_world: Rigid3, projector_name: str,
+                             projector_from_world: Rigid3, pattern_values, *, spp: int, seed: int,
+                             light_scales=None, time_s: float | None = None) -> np.ndarray:
+        """:meth:`render_ideal` lit by one projector showing ``pattern_values`` (as
+        :meth:`render_pattern`): the rectified images of active IR stereo."""
+        projector.show(self.device, projector_name, projector_from_world, pattern_values)
+        try:
+            return render_ideal(self.device, sensor_camera_name, camera, cam_from_world, spp=spp, seed=seed,
+                                light_scales=light_scales, time_s=time_s)
+        finally:
+            projector.all_off(self.device)
+
     def truth(self, camera, cam_from_world: Rigid3, row_poses=None, as_stored: bool = False,
               row_moves=None, *, time_s: float | None = None) -> dict[str, np.ndarray]:
         """Per-pixel truth of a camera at a pose and time (:func:`scenegen.render.truth.truth_pass`);

@@ -235,7 +235,8 @@ def _view_set(vs: m.ViewSet) -> dict:
 
 def _crossview(c) -> dict:
     d: dict[str, Any] = {"pairs": c.pairs if isinstance(c.pairs, str) else [list(p) for p in c.pairs]}
-    d.update(write_fields(c, ("pairs",)))
+    at_default = c.ir_depth_range_m == type(c).__dataclass_fields__["ir_depth_range_m"].default
+    d.update(write_fields(c, ("pairs",) + (("ir_depth_range_m",) if at_default else ())))  # omit_default
     if c.matches is not None:
         d["matches"] = write_fields(c.matches)
     return d

@@ -51,4 +51,7 @@ class CrossviewSpec:
     # an inlier within this distance of the truth
     targets: bool = param(True, unit="flag")  # per-view calibration-board corner truth (when
     # the scene has boards)
+    ir_depth_range_m: tuple[float, float] = param((0.0, 1000.0), unit="min and max depth z, metres", lo=0.0,
+                                                  omit_default=True)  # active IR stereo: a
+    # pixel whose depth lies outside is invalid, out of range (docs/dataset_format.md)
     where: Where | None = where_field()

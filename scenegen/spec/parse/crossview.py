@@ -42,7 +42,11 @@ def parse_crossview(node: Node, ctx: ParseContext) -> tuple[CrossviewSpec, Named
     else:
         pairs = read_enum(f, C, "pairs")
     matches = parse_matches(f.get("matches"), ctx) if "matches" in f else None
-    spec = C(pairs=pairs, matches=matches, **read_fields(f, C, skip=("pairs",)), where=node.where)
+    values = read_fields(f, C, skip=("pairs",))
+    lo, hi = values["ir_depth_range_m"]
+    if not lo < hi:
+        raise f.get("ir_depth_range_m").error(f"expected min < max, got {[lo, hi]}")
+    spec = C(pairs=pairs, matches=matches, **values, where=node.where)
     return spec, tuple(named)
 
 

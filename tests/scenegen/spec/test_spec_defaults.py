@@ -162,7 +162,7 @@ CASES = [
                    ("start_azimuth_deg", 10.0), ("up", UP))],
     *[(m.CrossviewSpec, k, CAM + "crossview: {}\n", lambda s, k=k: getattr(s.crossview, k), v)
       for k, v in (("pairs", "all"), ("flow", False), ("stereo", False), ("sift", True),
-                   ("sift_ratio", 0.7), ("sift_inlier_px", 3.0), ("targets", False))],
+                   ("sift_ratio", 0.7), ("sift_inlier_px", 3.0), ("targets", False), ("ir_depth_range_m", (0.5, 4.0)))],
     *[(m.MatchSetSpec, k, CAM + "crossview: {matches: {}}\n",
        lambda s, k=k: getattr(s.crossview.matches, k), v)
       for k, v in (("count", 10), ("sigma_px", 1.0), ("outlier_fraction", 0.1),
