@@ -19,7 +19,7 @@ import numpy as np
 from scenegen.geometry.pose import Rigid3
 from scenegen.render import raycast
 from scenegen.render.albedo import albedo_pass
-from scenegen.render.beams import cast_at_times
+from scenegen.render.beams import cast_at_times, cast_posed_rays
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
 from scenegen.render.frames import render_ideal, render_view
@@ -110,6 +110,12 @@ class Caster:
         rays (N, 3) each cast at its own time (N,) s with the moving objects there
         (:func:`scenegen.render.beams.cast_at_times`: a LiDAR's beams)."""
         return cast_at_times(self.device, origins_world, directions_world, times_s)
+
+    def cast_beams(self, rays):
+        """:class:`scenegen.spec.sensors.lidar_beams.RayHits` of a LiDAR's posed rays, each cast at
+        its own time, in one kernel (:func:`scenegen.render.beams.cast_posed_rays`: the
+        ``BeamCast`` a sweep takes)."""
+        return cast_posed_rays(self.device, rays)
 
     def _at(self, time_s: float | None) -> DeviceScene:
         self.device.place_at(time_s)
