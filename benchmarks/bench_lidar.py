@@ -59,7 +59,7 @@ def main(argv=None) -> int:
           f"{len(scene.description.movers)} moving objects")
 
     def sweep():
-        sweep_fields(scene.cast_at_times, lidar, pattern, traj, frames[0].time_s, noise_key=(1, "b", 0))
+        sweep_fields(scene.cast_beams, lidar, pattern, traj, frames[0].time_s, noise_key=(1, "b", 0))
 
     def raw():
         scene.device.place_at(frames[0].time_s)

@@ -203,6 +203,13 @@ class Composed(TrajectoryMixin):
         t = as_times(times_s)
         return self.parent.states_at(t).compose(self.child.states_at(t))
 
+    def poses_at(self, times_s) -> tuple[np.ndarray, np.ndarray]:
+        """The poses of :meth:`states_at` (:meth:`TrajectoryStates.compose`'s ``R``, ``t``, the
+        same bits) without the derivatives."""
+        t = as_times(times_s)
+        (Rp, tp), (Rc, tc) = self.parent.poses_at(t), self.child.poses_at(t)
+        return Rp @ Rc, tp + _rotate(Rp, tc)
+
 
 @dataclass(frozen=True, eq=False)
 class Shifted(TrajectoryMixin):

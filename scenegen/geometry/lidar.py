@@ -68,6 +68,24 @@ class ScanPattern:
         """(M, C, 3) unit beam directions in the LiDAR frame."""
         return self.unit_directions.copy()
 
+    @cached_property
+    def distinct_beam_times(self) -> tuple[np.ndarray, np.ndarray]:
+        """((U,) the distinct ``beam_time_s`` values, increasing; (M C,) each beam's index into
+        them), computed once (read-only): a spinning head whose channels fire together has one
+        time per column."""
+        offsets, index = np.unique(self.beam_time_s.reshape(-1), return_inverse=True)
+        offsets.flags.writeable = index.flags.writeable = False
+        return offsets, index
+
+    def beam_times_at(self, t0_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """``np.unique(t0_s + beam_time_s, return_inverse=True)`` (the distinct firing times of the
+        sweep that starts at ``t0_s`` s, and each beam's index into them), bit for bit, from
+        :attr:`distinct_beam_times`: adding ``t0_s`` keeps the order, and may only merge
+        neighbours that round to the same time."""
+        offsets, index = self.distinct_beam_times
+        times, merged = np.unique(t0_s + offsets, return_inverse=True)
+        return times, merged[index]
+
     def rings(self, elevations_rad=None) -> np.ndarray:
         """(C,) each beam column's ring: its rank by nominal elevation, 0 = lowest (the ``ring``
         of the Velodyne ROS driver and nuScenes' point clouds)."""
@@ -152,6 +170,21 @@ def footprint_directions(directions, offsets) -> np.ndarray:
     rays = ca * d[:, None, :] + sa * tangent
     rays[:, ang == 0] = d[:, None, :]
     return rays
+
+
+def dot3(x, y, zero=0.0):
+    """``x . y`` of 3-vectors given as components ``x[0], x[1], x[2]`` (numpy or Dr.Jit arrays
+    alike), summed as ``((x0 y0 + x2 y2) + x1 y1) + 0``: the order numpy's ``einsum`` sums a
+    3-term contraction in (numpy 2.4, x86-64; its accumulator starts at +0, so a -0 sum is +0),
+    written out so that a beam's rays and incidence have the same bits in numpy and in a
+    renderer's kernel. ``zero``: the 0 to add (a Dr.Jit kernel needs an opaque one: it drops a
+    literal ``+ 0.0``)."""
+    return ((x[0] * y[0] + x[2] * y[2]) + x[1] * y[1]) + zero
+
+
+def rotate3(R, v, zero=0.0) -> tuple:
+    """The components of ``R v``: ``R[i][j]`` and ``v[j]`` component arrays, each row by :func:`dot3`."""
+    return tuple(dot3(R[i], v, zero) for i in range(3))
 
 
 def return_intensity(reflectivity, cos_incidence, range_m, attenuation_per_m: float) -> np.ndarray:

@@ -234,6 +234,27 @@ class KeyframeTrajectory(TrajectoryMixin):
     def pose(self, t_s: float) -> Rigid3:
         return self.state(t_s).world_from_frame
 
+    def poses_at(self, times_s) -> tuple[np.ndarray, np.ndarray]:
+        """((N, 3, 3) R, (N, 3) t) world_from_frame at ``times_s`` (N,): :meth:`states_at`'s
+        poses, the same bits, without the derivatives (a LiDAR sweep's movers at 2,048 times)."""
+        t = as_times(times_s)
+        T = self.times_s
+        before, after = _held(t, T)
+        inside = ~(before | after)
+        R = np.where(after[:, None, None], self._R[-1], self._R[0])
+        pos = np.where(after[:, None], self._t[-1], self._t[0])
+        ti = t[inside]
+        if not len(ti):
+            return R, pos
+        if self.interpolation == "linear":
+            k, u = _segments(ti, T)
+            R[inside] = self._R[k] @ matrix_from_rotvec(u[:, None] * self._w[k]).reshape(-1, 3, 3)
+            pos[inside] = self._t[k] + u[:, None] * (self._t[k + 1] - self._t[k])
+        else:
+            R[inside] = self._R[0] @ matrix_from_rotvec(self._rot(ti, 0)).reshape(-1, 3, 3)
+            pos[inside] = self._pos(ti)
+        return R, pos
+
     def states_at(self, times_s) -> TrajectoryStates:
         """Poses and world-frame derivatives at ``times_s`` (N,) (module docstring; the same
         values as :meth:`state` at each time, to rounding)."""

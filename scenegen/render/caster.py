@@ -20,7 +20,7 @@ from scenegen.geometry.pose import Rigid3
 from scenegen.render import projector, raycast
 from scenegen.render.albedo import albedo_pass
 from scenegen.render.alone import alone_distances
-from scenegen.render.beams import cast_at_times
+from scenegen.render.beams import cast_at_times, cast_posed_rays
 from scenegen.render.correspond import correspond_in_kernel
 from scenegen.render.device import DeviceScene
 from scenegen.render.frames import render_ideal, render_view
@@ -159,6 +159,12 @@ class Caster:
         (+inf: missed; :func:`scenegen.render.raycast.first_hit_distance`)."""
         dev = self._at(time_s)
         return raycast.first_hit_distance(dev.scene, origin_world, directions_world, dev.alpha_masked)[0]
+
+    def cast_beams(self, rays):
+        """:class:`scenegen.spec.sensors.lidar_beams.RayHits` of a LiDAR's posed rays, each cast at
+        its own time, in one kernel (:func:`scenegen.render.beams.cast_posed_rays`: the
+        ``BeamCast`` a sweep takes)."""
+        return cast_posed_rays(self.device, rays)
 
     def _at(self, time_s: float | None) -> DeviceScene:
         self.device.place_at(time_s)

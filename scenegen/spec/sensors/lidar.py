@@ -215,7 +215,7 @@ def write_lidar(run: SensorRun) -> None:
     sw = StreamWriter(run.writer, run.stream, StreamSchema("lidar", member.sensor, schema_fields(pattern.shape[1])))
     for k, frame in enumerate(run.frames):
         t0 = frame.time_s + member.time_offset_s
-        fields = sweep_fields(run.scene.cast_at_times, lidar, pattern, lidar_trajectory(run, frame), t0,
+        fields = sweep_fields(run.scene.cast_beams, lidar, pattern, lidar_trajectory(run, frame), t0,
                               reflectivity=reflectivity, noise_key=(lidar.seed, run.stream, k))
         fields["sweep"] = np.full(pattern.shape[0], k, np.uint32)
         sw.write_chunk(k, t0 + pattern.sample_time_s, fields)

@@ -175,3 +175,15 @@ def test_path_motion_and_composition():
     for k, tau in enumerate(taus):
         want = pm.world_from_cam(float(tau))
         assert np.abs(R[k] - want.R).max() < 1e-14 and np.abs(t[k] - want.t).max() < 1e-14
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "spline"])
+def test_poses_at_are_the_states_poses_bit_for_bit(interpolation):
+    """poses_at skips the derivatives (a LiDAR sweep's movers) but not a bit of R and t, also
+    composed under a parent and held before and after the keyframes."""
+    traj = KeyframeTrajectory(TIMES, _poses(3), interpolation)
+    parent = KeyframeTrajectory(TIMES, _poses(4), "spline" if interpolation == "linear" else "linear")
+    for tr in (traj, Composed(parent, traj), Composed(traj, StaticTrajectory(_poses(5)[0]))):
+        R, t = tr.poses_at(QUERY)
+        s = tr.states_at(QUERY)
+        assert R.tobytes() == s.R.tobytes() and t.tobytes() == s.t.tobytes()

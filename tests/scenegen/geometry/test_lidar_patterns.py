@@ -6,10 +6,12 @@ import pytest
 
 from scenegen.geometry.lidar import (
     beam_directions,
+    dot3,
     footprint_directions,
     footprint_offsets,
     raster_pattern,
     return_intensity,
+    rotate3,
     select_returns,
     spinning_pattern,
 )
@@ -67,3 +69,41 @@ def test_first_strongest_and_last_returns_and_the_intensity_model():
     r, i = select_returns(rng_m, inten, np.isfinite(rng_m))
     assert np.array_equal(r[0], [10.0, 12.0, 12.0]) and np.array_equal(r[2], [np.inf] * 3)
     assert np.array_equal(i[2], [0, 0, 0]) and np.array_equal(r[1], [5.0, 5.0, 5.0])
+
+
+def test_beam_times_at_is_np_unique_of_the_sweep_times_bit_for_bit():
+    """The distinct times come from the pattern's own (cached) ones; adding a start time that
+    merges neighbours by rounding gives np.unique's answer all the same."""
+    osx = LIDAR_PRESETS["ouster_os1_64"]
+    vlp = LIDAR_PRESETS["velodyne_vlp16"]
+    for preset in (osx, vlp):
+        n = len(preset["elevations_deg"])
+        p = spinning_pattern(elevations_deg=preset["elevations_deg"],
+                             azimuth_offsets_deg=preset.get("azimuth_offsets_deg") or [0.0] * n,
+                             firing_offsets_s=np.asarray(preset.get("firing_offsets_us") or [0.0] * n) * 1e-6,
+                             columns=preset["columns"], rate_hz=preset["rate_hz"])
+        for t0 in (0.0, 0.1, 1234.5678, 3.0e10):  # at 3e10 s neighbouring firing times round together
+            want_t, want_i = np.unique(t0 + p.beam_time_s.reshape(-1), return_inverse=True)
+            got_t, got_i = p.beam_times_at(t0)
+            assert got_t.tobytes() == want_t.tobytes() and np.array_equal(got_i, want_i)
+    assert len(np.unique(3.0e10 + p.distinct_beam_times[0])) < len(p.distinct_beam_times[0])
+
+
+def test_dot3_and_rotate3_sum_in_einsums_order():
+    """The rays and incidence a kernel computes have numpy's einsum bits: the sum order and the
+    +0 of einsum's accumulator (signed zeros included), for a beam's axis and its footprint rays."""
+    rng = np.random.default_rng(30)
+    def mixed(shape):  # with exact zeros of both signs
+        a = rng.standard_normal(shape)
+        u = rng.random(shape)
+        a[u < 0.2], a[(u >= 0.2) & (u < 0.4)] = 0.0, -0.0
+        return a
+    R, d, rays = mixed((20000, 3, 3)), mixed((20000, 3)), mixed((20000, 4, 3))
+    got = np.stack(rotate3([[R[:, i, j] for j in range(3)] for i in range(3)], [d[:, j] for j in range(3)]), 1)
+    assert got.tobytes() == np.einsum("nij,nj->ni", R, d).tobytes()
+    got = np.stack(rotate3([[R[:, None, i, j] for j in range(3)] for i in range(3)], [rays[..., j] for j in range(3)]), -1)
+    assert got.tobytes() == np.einsum("nij,nfj->nfi", R, rays).tobytes()
+    assert dot3([rays[..., i] for i in range(3)], [rays[:, ::-1, i] for i in range(3)]).tobytes() == \
+        np.einsum("nfi,nfi->nf", rays, rays[:, ::-1]).tobytes()
+    assert not np.array_equal(np.signbit(R[:, 0, 0] * d[:, 0] + R[:, 0, 1] * d[:, 1] + R[:, 0, 2] * d[:, 2]),
+                              np.signbit(got[:, 0, 0]))  # plain summation differs (signs of zero, order)

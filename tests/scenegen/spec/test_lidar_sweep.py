@@ -8,6 +8,7 @@ import numpy as np
 from scenegen.geometry.clock import StaticTrajectory
 from scenegen.geometry.pose import Rigid3
 from scenegen.spec.sensors.lidar import LidarSpec
+from scenegen.spec.sensors.lidar_beams import beam_cast_by_rays
 from scenegen.spec.sensors.lidar_sweep import sweep_fields
 
 HEIGHT = 2.0  # the LiDAR above the ground plane z = 0
@@ -34,7 +35,7 @@ POSE = StaticTrajectory(Rigid3(np.eye(3), np.array([0.0, 0.0, HEIGHT])))
 
 
 def sweep(spec, key=(1, "s", 0), traj=POSE):
-    return sweep_fields(ground, spec, spec.scan_pattern(), traj, 0.0, reflectivity={2: 0.2}, noise_key=key)
+    return sweep_fields(beam_cast_by_rays(ground), spec, spec.scan_pattern(), traj, 0.0, reflectivity={2: 0.2}, noise_key=key)
 
 
 def test_truth_is_the_closed_form_and_noise_has_its_sigma_and_seed():
