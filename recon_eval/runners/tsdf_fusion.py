@@ -52,16 +52,22 @@ def _o3d():
     return o3d
 
 
-def _intrinsic(cam):
+def _check_pinhole(cam) -> None:
     if cam.model != "pinhole" and any(cam.dist):
         raise NotApplicable(f"TSDF fusion needs pinhole depth frames, got a {cam.model} camera with distortion")
     if cam.skew != 0.0:
         raise NotApplicable("TSDF fusion needs a camera without skew")
-    return _o3d().camera.PinholeCameraIntrinsic(cam.width, cam.height, cam.fx, cam.fy, cam.cx, cam.cy)
 
 
-def _K(cam) -> np.ndarray:
+def camera_matrix(cam) -> np.ndarray:
+    """K (3, 3) px of a scenegen camera."""
     return np.array([[cam.fx, 0.0, cam.cx], [0.0, cam.fy, cam.cy], [0.0, 0.0, 1.0]])
+
+
+def pinhole_intrinsic(K: np.ndarray, width: int, height: int):
+    """Open3D's ``PinholeCameraIntrinsic`` of K (3, 3) px and the image size (px); Open3D's pixel
+    coordinates are OpenCV's (integer pixel centres)."""
+    return _o3d().camera.PinholeCameraIntrinsic(int(width), int(height), K[0, 0], K[1, 1], K[0, 2], K[1, 2])
 
 
 def _depth_image(depth_m: np.ndarray):
@@ -129,13 +135,13 @@ def chain(cam0_from_world: np.ndarray, prev_from_cur: list) -> list:
     return poses
 
 
-def observed_truth_points(depths_m, cams, cam_from_world) -> np.ndarray:
+def observed_truth_points(depths_m, K: np.ndarray, cam_from_world) -> np.ndarray:
     """(N, 3) world points: every frame's truth depth back-projected (pixel centres, OpenCV)."""
     out = []
-    for d, cam, T in zip(depths_m, cams, cam_from_world):
+    for d, T in zip(depths_m, cam_from_world):
         v, u = np.nonzero(np.isfinite(d))
         z = d[v, u]
-        xyz = np.stack([(u - cam.cx) / cam.fx * z, (v - cam.cy) / cam.fy * z, z], axis=1)
+        xyz = np.stack([(u - K[0, 2]) / K[0, 0] * z, (v - K[1, 2]) / K[1, 1] * z, z], axis=1)
         R, t = T[:3, :3], T[:3, 3]
         out.append((xyz - t) @ R)  # world = R^T (cam - t)
     return np.concatenate(out) if out else np.zeros((0, 3))
@@ -205,11 +211,13 @@ def run(ds, out_dir, options: dict) -> RunOutput:
     cams, Ts = zip(*(ds.camera(v) for v in views))
     if len({(c.width, c.height, c.fx, c.fy, c.cx, c.cy) for c in cams}) != 1:
         raise NotApplicable(f"{ds.root}: TSDF fusion needs one depth camera for every frame")
-    intrinsic = _intrinsic(cams[0])
+    _check_pinhole(cams[0])
+    K = camera_matrix(cams[0])
+    intrinsic = pinhole_intrinsic(K, cams[0].width, cams[0].height)
     depths = [ds.depth(v) for v in views]
     truth_T = [T.matrix for T in Ts]
     gt_mesh = ds.mesh()
-    truth_points = observed_truth_points(depths, cams, truth_T)
+    truth_points = observed_truth_points(depths, K, truth_T)
     tracked_T = chain(truth_T[0], track(depths, intrinsic))
     res = RunOutput(notes={"frames": len(views), "voxel_m": VOXEL_M, "trunc_m": TRUNC_VOXELS * VOXEL_M,
                            "depth": "depth_z truth", "tracking": "frame-to-frame point-to-plane ICP, "
@@ -217,7 +225,7 @@ def run(ds, out_dir, options: dict) -> RunOutput:
     traj = out_path(out_dir, "trajectory_tracked.txt")
     _write_tum(traj, views, tracked_T)
     for label, poses in (("truth_poses", truth_T), ("tracked_poses", tracked_T)):
-        V, F = fuse(depths, _K(cams[0]), poses)
+        V, F = fuse(depths, K, poses)
         path = out_path(out_dir, f"mesh_{label}.ply")
         _write_mesh(path, V, F)
         m = trimesh.load(path, process=False, force="mesh")
