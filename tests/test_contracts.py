@@ -25,7 +25,7 @@ RECON_EVAL_MAY_IMPORT = ("scenegen.geometry", "scenegen.dataset", "scenegen.erro
 LAZY_ALLOWED = ("cv2", "mitsuba", "drjit", "matplotlib", "dask", "distributed", "pycolmap", "trimesh", "rich",
                 "scipy",
                 "mujoco",  # the rigid-body engine: only a spec with `placement:` runs it (scenegen.physics)
-                "open3d",  # the `runners` extra: only the alignment runner needs it (recon_eval.runners.objects_align)
+                "open3d",  # the `runners` extra: only the alignment and TSDF fusion runners need it (recon_eval.runners.objects_align, .tsdf_fusion)
                 "scenegen.render.scene", "scenegen.render.raycast", "scenegen.render.drjit_ops")
 #: The command line loads each command's implementation when the command runs, so that
 #: ``scenegen --help`` costs less than ``import numpy`` (docs/performance.md, "Start-up").

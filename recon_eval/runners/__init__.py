@@ -7,7 +7,7 @@ findHomography), :mod:`.fsurvey` (the nineteen F estimators of Armangue and Salv
 :mod:`.colmap` (pycolmap incremental SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
-(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.near_light` (under point lights), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming),
+(Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.near_light` (under point lights), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming), :mod:`.tsdf_fusion` (KinectFusion-style TSDF fusion of depth frames),
 :mod:`.external`
 (a user's own command line, declared in a methods file or with ``run --command``:
 :mod:`.declared`); shared:
@@ -76,7 +76,7 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("external_views", "dlt"): "DLT camera matrices", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
          ("external_sequence", "trajectory"): "camera trajectory",
          ("objects_align", None): "6D object pose (BOP)", ("objects_features", None): "6D object pose (BOP)",
-         ("objects_parts", None): "articulated object pose"}
+         ("objects_parts", None): "articulated object pose", ("tsdf_fusion", None): "TSDF fusion (depth sweep)"}
 
 
 def _m(name, module, function, description, **options):
@@ -177,6 +177,10 @@ METHODS: dict[str, Method] = {m.name: m for m in [
     _m("parts-align-joints", "objects_parts", "run",
        "parts: each part of an articulated object posed alone by the alignment method, joints recovered as the "
        "parts' relative rotations; BOP19 CSV, per-part and joint errors"),
+    _m("o3d-tsdf-fusion", "tsdf_fusion", "run",
+       "KinectFusion-style: Open3D VoxelBlockGrid TSDF fusion (4 mm voxels) of the depth frames with the truth "
+       "poses and with poses tracked frame to frame (point-to-plane ICP), marching cubes; scored against the "
+       "truth mesh (Tanks and Temples F at 5 / 10 mm, DTU) and the tracked trajectory's APE"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.
