@@ -7,7 +7,10 @@ chained rotation between two times matches the truth's relative rotation."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from recon_eval.errors import NotApplicable
+from recon_eval.runners import run_method
 from recon_eval.runners.inertial import gyro_rotation, integrate_imu
 from scenegen.geometry.clock import Composed, StaticTrajectory
 from scenegen.geometry.imu import NOISE_PRESETS, imu_noise, imu_truth, sample_times_s
@@ -66,3 +69,9 @@ def test_the_gyroscope_rotation_between_two_times_is_the_truths():
         # the trapezoid of the rate over 5 ms steps: an O(dt^2) error per second, ~1e-4 rad here
         assert rotation_angle_rad(R.T @ (truth.R[i0].T @ truth.R[i1])) < 1e-3
         assert rotation_angle_rad(truth.R[i0].T @ truth.R[i1]) > 0.02  # it turns
+
+
+def test_a_dataset_without_a_stereo_sequence_is_not_applicable(plane_dataset, tmp_path):
+    for name in ("stereo-vo-pnp", "imu-dead-reckoning"):
+        with pytest.raises(NotApplicable, match="rectified stereo frames; odometry needs a sequence"):
+            run_method(name, plane_dataset[0], tmp_path / name)
