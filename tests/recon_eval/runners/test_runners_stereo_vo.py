@@ -94,3 +94,10 @@ def test_the_baseline_drifts_and_both_write_tum_trajectories_of_the_truths_times
         assert np.allclose(est.poses.t_cam_from_world[0], gt.poses.t_cam_from_world[0], atol=1e-6)
         doc = json.loads((root / run / "result.json").read_text())
         assert doc["inputs"]["task"] == "stereo odometry"
+
+
+def test_a_second_run_writes_the_same_bytes(runs, tmp_path):
+    root, vo, _ = runs
+    again = run_method("stereo-vo-pnp", root / "data", tmp_path / "vo", write=False)
+    assert (tmp_path / "vo" / "trajectory.txt").read_bytes() == (root / "vo" / "trajectory.txt").read_bytes()
+    assert again["metrics"] == vo["metrics"]
