@@ -15,11 +15,14 @@ pinhole with baseline B):
    threshold :data:`RANSAC_PX`, 0.999 confidence, OpenCV's RNG seeded per frame) then
    ``cv2.solvePnPRefineLM`` on the inliers: ``cam_k_from_cam_k-1``; chained from the truth pose of
    the first frame (world_from_cam_k = world_from_cam_k-1 @ cam_k-1_from_cam_k);
-6. outlier detection against the odometry (the mapping robot's check; here the IMU's gyroscope,
-   where the dataset has an IMU stream): a step whose rotation differs from the gyroscope's
-   rotation between the two frame times by more than :data:`GYRO_GATE_DEG`, or with fewer than
-   :data:`MIN_INLIERS` PnP inliers, is rejected and replaced by the gyroscope's rotation with the
-   previous accepted step's translation (constant velocity). The camera-IMU extrinsic rotation is
+6. outlier detection against the odometry (the mapping robot's check), with what the dataset has:
+   the IMU's gyroscope (a step whose rotation differs from the gyroscope's rotation between the two
+   frame times by more than :data:`GYRO_GATE_DEG`) and the wheel odometry (a step whose length
+   differs from the distance the integrated wheel odometry travelled between the two frame times by
+   more than :data:`WHEEL_GATE_M` plus :data:`WHEEL_GATE_FRACTION` of it); such a step, or one with
+   fewer than :data:`MIN_INLIERS` PnP inliers, is rejected and replaced by the gyroscope's rotation
+   (else the previous step's) and the previous accepted step's translation (constant velocity),
+   scaled to the wheels' distance where there are wheels. The camera-IMU extrinsic rotation is
    taken from the truth at the first frame (a calibrated rig).
 
 Scored as :func:`.odometry_common.score_trajectory` (SE(3) APE / RPE, KITTI t_err / r_err).
@@ -44,6 +47,8 @@ FB_TOL_PX = 0.5
 RANSAC_PX = 0.5
 MIN_INLIERS = 12
 GYRO_GATE_DEG = 1.0
+WHEEL_GATE_M = 0.05
+WHEEL_GATE_FRACTION = 0.1
 LK = dict(winSize=(11, 11), maxLevel=3, criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 40, 0.01))
 
 
@@ -98,13 +103,35 @@ def _cam_rotations_from_gyro(ds, seq):
     return lambda k: R_imu_from_cam.T @ gyro_rotation(stamps, gyro, seq.times_s[k - 1], seq.times_s[k]) @ R_imu_from_cam
 
 
+def _wheel_distances(ds, seq):
+    """``dist(k) -> m`` travelled by the integrated wheel odometry from frame k - 1 to frame k (its
+    planar path length, interpolated in time), or None without a wheel odometry stream."""
+    names = ds.streams.of_kind("wheel_odometry")
+    if not names:
+        return None
+    s = ds.streams[names[0]]
+    stamps, xy = s.field("stamp_s"), s.field("odom_pose")[:, :2]
+    travelled = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))]
+    return lambda k: float(np.interp(seq.times_s[k], stamps, travelled) - np.interp(seq.times_s[k - 1], stamps, travelled))
+
+
+def _fallback(R_gyro, last_step, wheel_m):
+    """The replacement of a rejected step (module docstring, step 6), or None with nothing to go on."""
+    if R_gyro is None and last_step is None:
+        return None
+    t = last_step.t if last_step is not None else np.zeros(3)
+    if wheel_m is not None and np.linalg.norm(t) > 0:
+        t = t / np.linalg.norm(t) * wheel_m
+    return Rigid3(R_gyro if R_gyro is not None else last_step.R, t)
+
+
 def run(ds, out_dir, options) -> RunOutput:
     """``stereo-vo-pnp`` (module docstring)."""
     seq = stereo_sequence(ds)
     cam = seq.frames[0].camera
     K = np.asarray(cam.K, float)
     f, cx, cy, B = float(K[0, 0]), float(K[0, 2]), float(K[1, 2]), float(seq.frames[0].baseline_m)
-    gyro = _cam_rotations_from_gyro(ds, seq)
+    gyro, wheels = _cam_rotations_from_gyro(ds, seq), _wheel_distances(ds, seq)
     images = [tuple(to_grey8(ds.read(fr.image, s)) for s in ("left", "right")) for fr in seq.frames]
     est, last_step, rejected, inliers = [seq.world_from_cam[0]], None, [], []
     for k in range(1, len(seq.frames)):
@@ -115,20 +142,19 @@ def run(ds, out_dir, options) -> RunOutput:
         inliers.append(n)
         prev_from_cur = step.inverse() if step is not None else None
         R_gyro = gyro(k) if gyro is not None else None
+        wheel_m = wheels(k) if wheels is not None else None
         bad = prev_from_cur is None or n < MIN_INLIERS or (
-            R_gyro is not None and np.degrees(rotation_angle_rad(prev_from_cur.R.T @ R_gyro)) > GYRO_GATE_DEG)
-        if bad and (R_gyro is not None or last_step is not None):
+            R_gyro is not None and np.degrees(rotation_angle_rad(prev_from_cur.R.T @ R_gyro)) > GYRO_GATE_DEG) or (
+            wheel_m is not None and abs(np.linalg.norm(prev_from_cur.t) - wheel_m) > WHEEL_GATE_M + WHEEL_GATE_FRACTION * wheel_m)
+        if bad:
             rejected.append(k)
-            t = last_step.t if last_step is not None else np.zeros(3)
-            prev_from_cur = Rigid3(R_gyro if R_gyro is not None else last_step.R, t)
-        elif prev_from_cur is None:  # nothing to fall back on: hold the pose
-            rejected.append(k)
-            prev_from_cur = Rigid3.identity()
+            fallback = _fallback(R_gyro, last_step, wheel_m)
+            prev_from_cur = fallback if fallback is not None else Rigid3.identity()  # nothing to go on: hold
         else:
             last_step = prev_from_cur
         est.append(est[-1] @ prev_from_cur)
     out = RunOutput()
-    out.notes.update({"rejected_steps": rejected, "gyro_check": gyro is not None,
+    out.notes.update({"rejected_steps": rejected, "gyro_check": gyro is not None, "wheel_check": wheels is not None,
                       "median_pnp_inliers": float(np.median(inliers))})
     score_trajectory(out, out_dir, seq, est)
     out.metrics["rejected_step_fraction"] = len(rejected) / (len(seq.frames) - 1)
