@@ -1,7 +1,8 @@
 """The stereo odometry runner (``stereo-vo-pnp``) and the IMU-only baseline
 (``imu-dead-reckoning``) end to end on a tiny rendered driving sequence: a stereo rig (0.5 m
 baseline, 96x72) drives 4 m down a textured corridor in 2 s along a C2 spline that turns, an IMU
-with EuRoC's ADIS16448 noise rides on the same trajectory; 11 frames at 5 fps.
+with EuRoC's ADIS16448 noise and a differential drive's wheel odometry ride on the same trajectory
+(the outlier checks of both on); 11 frames at 5 fps.
 
 The bounds: the stereo odometry's APE RMSE (poses chained from the true first pose, no further
 alignment) below 10 % of the 4 m path: a sanity bound, stated as such (it shows that the pipeline
@@ -43,11 +44,16 @@ cameras:
   cam: {size: [96, 72], fx: 72}
 imus:
   imu0: {rate_hz: 200, preset: euroc_adis16448}
+wheel_odometry:
+  wheels: {rate_hz: 50, wheel_radius_m: 0.3, track_width_m: 1.6, wheel_speed_noise_rad_s: 0.05}
 rigs:
   car: {type: stereo, left: cam, right: cam, baseline_m: 0.5}
   car_imu:
     type: multi
-    members: [{kind: imu, sensor: imu0, name: imu, rig_from_sensor: {translation: [0.25, 0.3, -0.2]}}]
+    members:
+      - {kind: imu, sensor: imu0, name: imu, rig_from_sensor: {translation: [0.25, 0.3, -0.2]}}
+      - {kind: wheel_odometry, sensor: wheels, name: base,
+         rig_from_sensor: {translation: [0.25, 1.2, -0.5], rotation_deg: [90, -90, 0]}}
 views:
   - rig: car
     trajectory: &drive
@@ -75,7 +81,8 @@ def runs(tmp_path_factory):
 def test_the_stereo_odometry_tracks_the_drive_within_the_sanity_bound(runs):
     root, vo, imu = runs
     m, b = vo["metrics"], imu["metrics"]
-    assert vo["inputs"]["notes"]["frames"] == 11 and vo["inputs"]["notes"]["gyro_check"] is True
+    notes = vo["inputs"]["notes"]
+    assert notes["frames"] == 11 and notes["gyro_check"] is True and notes["wheel_check"] is True
     path = vo["inputs"]["notes"]["path_length_m"]
     assert 3.8 < path < 4.5
     assert m["ape_trans_rmse_m"] < 0.1 * path, m  # the sanity bound (module docstring)
