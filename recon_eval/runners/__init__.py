@@ -5,6 +5,7 @@ One module per method family: :mod:`.calibration` (OpenCV calibrateCamera / fish
 findHomography), :mod:`.fsurvey` (the nineteen F estimators of Armangue and Salvi's survey,
 :mod:`recon_eval.estimators.fundamental`), :mod:`.pnp` (solvePnP / solvePnPRansac),
 :mod:`.colmap` (pycolmap incremental SfM), :mod:`.dlt` (linear DLT camera matrices), :mod:`.triangulate` (cv2.triangulatePoints),
+:mod:`.stereo_vo` (the course's stereo odometry), :mod:`.inertial` (IMU dead reckoning),
 :mod:`.features` (OpenCV keypoints and descriptors, mutual nearest-neighbour matching),
 :mod:`.flow` (DIS and Farneback dense flow, pyramidal Lucas-Kanade tracks), :mod:`.photometric`
 (Woodham's photometric stereo, Frankot-Chellappa integration), :mod:`.near_light` (under point lights), :mod:`.focus` (depth from focus), :mod:`.shading` (shape from shading), :mod:`.texture` (shape from texture), :mod:`.zoom` (depth from zooming), :mod:`.tsdf_fusion` (KinectFusion-style TSDF fusion of depth frames),
@@ -76,7 +77,8 @@ TASKS = {("calibration", None): "calibration", ("stereo", None): "stereo dispari
          ("external_views", "dlt"): "DLT camera matrices", ("external_sequence", "tracks"): "point tracks (TAP-Vid)",
          ("external_sequence", "trajectory"): "camera trajectory",
          ("objects_align", None): "6D object pose (BOP)", ("objects_features", None): "6D object pose (BOP)",
-         ("objects_parts", None): "articulated object pose", ("tsdf_fusion", None): "TSDF fusion (depth sweep)"}
+         ("objects_parts", None): "articulated object pose", ("tsdf_fusion", None): "TSDF fusion (depth sweep)",
+         ("stereo_vo", None): "stereo odometry", ("inertial", None): "stereo odometry"}
 
 
 def _m(name, module, function, description, **options):
@@ -181,6 +183,12 @@ METHODS: dict[str, Method] = {m.name: m for m in [
        "KinectFusion-style: Open3D VoxelBlockGrid TSDF fusion (4 mm voxels) of the depth frames with the truth "
        "poses and with poses tracked frame to frame (point-to-plane ICP), marching cubes; scored against the "
        "truth mesh (Tanks and Temples F at 5 / 10 mm, DTU) and the tracked trajectory's APE"),
+    _m("stereo-vo-pnp", "stereo_vo", "run",
+       "stereo odometry: goodFeaturesToTrack corners, LK left-right matching along rows, stereo triangulation, "
+       "LK temporal tracks, solvePnPRansac (EPnP) + LM against the previous frame, chained; steps rejected "
+       "against the gyroscope (1 deg) replaced by it (constant velocity); TUM trajectory"),
+    _m("imu-dead-reckoning", "inertial", "run",
+       "IMU-only baseline: RK4 integration of the measured IMU stream from the true initial state; TUM trajectory"),
 ]}
 
 #: Deliberately broken estimators (:mod:`.faults`): for showing that gates fail, never for results.
