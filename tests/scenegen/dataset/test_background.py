@@ -99,3 +99,10 @@ def test_leaving_on_an_error_still_records_what_was_submitted(tmp_path):
             bg.submit(VIEWS[0], **make_view(0))
             raise KeyboardInterrupt
     assert w.completed_views == (VIEWS[0],)
+
+
+def test_writer_threads_follow_the_cores_and_the_renders_share():
+    assert background.writer_threads(render_on_cpu=True, cores=2) == 2  # at least 2: fsyncs wait beside encoding
+    assert background.writer_threads(render_on_cpu=True, cores=8) == 4  # the CPU render holds the cores
+    assert background.writer_threads(render_on_cpu=False, cores=6) == 6  # a GPU render leaves them all
+    assert background.writer_threads(render_on_cpu=False, cores=64) == background.MAX_WORKERS
