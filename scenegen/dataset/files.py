@@ -91,6 +91,14 @@ def atomic_write_files(items) -> None:
     fsync'ed, then they are renamed in order, then each directory is fsync'ed once, so all of them
     are durable when this returns (a view's files, before the view is recorded). If anything
     fails, the temporary files not yet renamed are removed; renamed ones stay, each complete."""
+    commit_staged(stage_files(items))
+    fsync_dirs(items)
+
+
+def stage_files(items) -> list[tuple[Path, Path]]:
+    """The first half of :func:`atomic_write_files`: write and fsync each file's bytes to a
+    temporary file beside it; returns ``[(temporary, final path)]`` for :func:`commit_staged`.
+    Safe on worker threads (touches no final name). On an error, nothing staged is left."""
     staged: list[tuple[Path, Path]] = []
     try:
         for path, data in items.items():
@@ -103,20 +111,43 @@ def atomic_write_files(items) -> None:
                 write_payload(f, data)
                 f.flush()
                 os.fsync(f.fileno())
+    except BaseException as e:
+        discard_staged(staged)
+        if isinstance(e, OSError) and e.errno is not None and staged:
+            raise named_os_error(e, staged[-1][1]) from None
+        raise
+    return staged
+
+
+def commit_staged(staged: list[tuple[Path, Path]]) -> None:
+    """Rename staged files over their final names, in order; on an error the ones not yet renamed
+    are removed (renamed ones stay, each complete). Their directories still need
+    :func:`fsync_dirs` before the renames are durable."""
+    staged = list(staged)
+    try:
         while staged:
             tmp, path = staged[0]
             os.replace(tmp, path)
             staged.pop(0)
     except BaseException as e:
-        for tmp, _ in staged:
-            try:
-                os.unlink(tmp)
-            except FileNotFoundError:
-                pass
+        discard_staged(staged)
         if isinstance(e, OSError) and e.errno is not None and staged:
             raise named_os_error(e, staged[0][1]) from None
         raise
-    for directory in dict.fromkeys(Path(p).parent for p in items):
+
+
+def discard_staged(staged) -> None:
+    """Remove staged temporary files (a view that will not be committed)."""
+    for tmp, _ in staged:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+
+
+def fsync_dirs(paths) -> None:
+    """fsync each distinct parent directory of ``paths`` once (renames in them made durable)."""
+    for directory in dict.fromkeys(Path(p).parent for p in paths):
         fsync_dir(directory)
 
 

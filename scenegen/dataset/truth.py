@@ -20,7 +20,7 @@ from typing import Mapping
 
 import numpy as np
 
-from scenegen.dataset.codecs.exr import encode_exr, pack_channels, unpack_channels
+from scenegen.dataset.codecs.exr import DEFAULT_EXR_COMPRESSION, encode_exr, pack_channels, unpack_channels
 from scenegen.dataset.codecs.png import encode_png
 from scenegen.dataset.truth_kinds import (TRUTH_DISTANCE_KEYS, TRUTH_FLOAT_CHANNELS, TRUTH_ID_KEYS, TRUTH_KEYS,  # noqa: F401
                                           TRUTH_KIND_INFO, TruthKind, TruthKindInfo)
@@ -108,13 +108,15 @@ def truth_id_channels(truth: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {k.value: truth[k] for k in TRUTH_ID_KEYS}
 
 
-def encode_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None) -> dict[str, bytes]:
+def encode_truth(truth: Mapping[str, np.ndarray], shape: tuple[int, int] | None = None,
+                 exr_compression: str = DEFAULT_EXR_COMPRESSION) -> dict[str, bytes]:
     """The three truth files of a view, by key ``truth``, ``ids``, ``valid`` (see the module
-    docstring); ``truth`` is checked with :func:`check_truth` first."""
+    docstring); ``truth`` is checked with :func:`check_truth` first. ``exr_compression``: of
+    :data:`scenegen.dataset.codecs.exr.EXR_COMPRESSIONS` (the spec's ``render.exr_compression``)."""
     t = check_truth(truth, shape=shape)
     return {
-        "truth": encode_exr(truth_float_channels(t)),
-        "ids": encode_exr(truth_id_channels(t)),
+        "truth": encode_exr(truth_float_channels(t), exr_compression),
+        "ids": encode_exr(truth_id_channels(t), exr_compression),
         "valid": encode_png(np.where(t[TruthKind.VALID], np.uint8(VALID_PNG_VALUE), np.uint8(0))),
     }
 

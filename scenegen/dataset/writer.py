@@ -14,7 +14,7 @@ import os
 import re
 import shutil
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -22,7 +22,9 @@ from scenegen.dataset.cameras import ViewCamera, cameras_document
 from scenegen.dataset.codecs.json import decode_json, encode_json
 from scenegen.dataset.codecs.ply import encode_ply
 from scenegen.dataset.errors import DatasetError, DatasetMismatchError
-from scenegen.dataset.files import atomic_write_bytes, atomic_write_files, remove_stale_temp_files, sha256_bytes
+from scenegen.dataset.codecs.exr import DEFAULT_EXR_COMPRESSION
+from scenegen.dataset.files import atomic_write_bytes, commit_staged, discard_staged, fsync_dirs
+from scenegen.dataset.files import remove_stale_temp_files, sha256_bytes
 from scenegen.dataset.journal import (
     JournalAppender,
     file_record,
@@ -50,7 +52,7 @@ from scenegen.dataset.manifest import (
     load_manifest,
     manifest_bytes_and_sha256,
 )
-from scenegen.dataset.view_files import checked_extra_files, encode_view
+from scenegen.dataset.view_files import StagedView, stage_view
 
 
 class DatasetWriter:
@@ -219,18 +221,31 @@ class DatasetWriter:
         if new:
             self._log([file_record(rel, sha) for rel, sha in new.items()])
 
-    def write_view(self, view: str, *, image, linear_rgb, truth,
-                   extra_files: Mapping[str, bytes] | None = None) -> None:
-        """Encode, write and hash one view's files, then mark it complete in the manifest.
+    def write_view(self, view: str, *, image, linear_rgb, truth, extra_files: Mapping[str, bytes] | None = None,
+                   exr_compression: str = DEFAULT_EXR_COMPRESSION) -> None:
+        """Encode, write and hash one view's files, then record it (:func:`write_view_files`)."""
+        self.commit_views([stage_view(self.root, view, image=image, linear_rgb=linear_rgb, truth=truth,
+                                      extra_files=extra_files, exr_compression=exr_compression)])
 
-        Arguments as in :func:`encode_view`; ``extra_files`` as in :func:`write_view_files`.
-        """
-        files = encode_view(view, image=image, linear_rgb=linear_rgb, truth=truth)
-        files.update(checked_extra_files(view, extra_files, files))
-        hashes = {rel: sha256_bytes(d) for rel, d in files.items()}
-        self._check_rerecord(view, hashes)  # before writing anything
-        atomic_write_files({self.root / rel: data for rel, data in files.items()})  # durable, then recorded
-        self.record_view(view, hashes)
+    def commit_views(self, staged: Sequence[StagedView]) -> None:
+        """Record views whose files :func:`stage_view` staged, in order: each checked (as
+        :meth:`write_view` does) and renamed, then each distinct directory fsync'd once, then one
+        fsync'd journal batch. On an error the views before it are still recorded, the ones from
+        it on are not (their temporary files removed)."""
+        done: list[StagedView] = []
+        try:
+            for i, sv in enumerate(staged):
+                try:
+                    self._check_rerecord(sv.view, sv.hashes)  # before any final name is touched
+                    commit_staged(sv.staged)  # durable with the directory fsync below, then recorded
+                except BaseException:  # renamed temporaries are gone: removing them is a no-op
+                    discard_staged([f for later in staged[i:] for f in later.staged])
+                    raise
+                done.append(sv)
+        finally:
+            if done:
+                fsync_dirs([path for sv in done for _, path in sv.staged])
+                self.record_views({sv.view: sv.hashes for sv in done})
 
     def record_view(self, view: str, file_hashes: Mapping[str, str]) -> None:
         """Mark ``view`` complete with the files (``{relative path: sha256}``) already written,

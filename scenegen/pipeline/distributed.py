@@ -127,7 +127,7 @@ def render_frame_task(source, out_dir: str, items, spp: int, seed: int, variant:
             raise RuntimeError(f"worker resolved view {index} as {v.name!r}, the client as {name!r}")
         image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
         out.append((name, write_view_files(out_dir, name, image=image, linear_rgb=linear, truth=truth,
-                                              extra_files=extra)))
+                                              extra_files=extra, exr_compression=spec.render.exr_compression)))
         del image, linear, truth, extra  # release the frame's buffers before the next
         _STATS["views_rendered"] += 1
     return out

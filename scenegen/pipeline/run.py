@@ -9,7 +9,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from scenegen.dataset.background import BackgroundWriter
+from scenegen.dataset.background import BackgroundWriter, writer_threads
 from scenegen.dataset.cameras import ViewCamera
 from scenegen.dataset.codecs import encode_json
 from scenegen.dataset.layout import target_path
@@ -154,11 +154,13 @@ def _write_dataset(spec, views, wanted, built, writer: DatasetWriter, used: Rend
         if dask_client is not None:  # workers render and write; recorded here as their tasks finish
             rendered = render_views_dask(dask_client, source, writer, pending, spp=spp, seed=seed,
                                          variant=used.variant, on_done=bar.advance)
-        else:  # a view is encoded and written on a thread while the next one renders
-            with BackgroundWriter(writer) as background:
+        else:  # views are encoded and written on a pool of threads while the next ones render
+            with BackgroundWriter(writer, workers=writer_threads(render_on_cpu=not used.variant.startswith("cuda"))) \
+                    as background:
                 for index, v in pending:
                     image, linear, truth, extra = render_view_data(spec, built, index, v, spp=spp, seed=seed)
-                    background.submit(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra)
+                    background.submit(v.name, image=image, linear_rgb=linear, truth=truth, extra_files=extra,
+                                      exr_compression=spec.render.exr_compression)
                     del image, linear, truth, extra  # the writer holds the only references
                     rendered += 1
                     bar.advance()

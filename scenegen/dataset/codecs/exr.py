@@ -1,11 +1,14 @@
-"""OpenEXR: one part, scanlines, ZIP compression; each channel is (H, W) float32 (stored as FLOAT,
+"""OpenEXR: one part, scanlines, ZIP compression (or another lossless one of :data:`EXR_COMPRESSIONS`
+for a view's files, ``render.exr_compression``); each channel is (H, W) float32 (stored as FLOAT,
 never HALF) or uint32 (UINT), bit-exact. Vector quantities are stored one channel per component,
 named ``<prefix>.<component>`` (``P_world.X``, ``uv.U``): :func:`pack_channels`.
 """
 from __future__ import annotations
 
 import io
+from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Iterable, Mapping, Sequence
 
 import numpy as np
@@ -15,6 +18,26 @@ from scenegen.dataset.files import atomic_write_bytes
 from scenegen.quiet import quiet_native_output
 
 _EXR_DTYPES = (np.dtype(np.float32), np.dtype(np.uint32))
+
+
+@dataclass(frozen=True)
+class ExrCompression:
+    """A lossless OpenEXR compression a dataset's view files may use, and who reads it back."""
+
+    openexr_name: str  # the OpenEXR binding's constant, ``<name>_COMPRESSION``
+    opencv_reads: bool  # OpenCV 4.14 (its bundled OpenEXR) decodes it (R, G, B files: the linear image)
+
+
+#: ``render.exr_compression`` -> the compression (all lossless, bit-exact for FLOAT and UINT;
+#: measured in docs/performance.md). ZIP is the format's default; ZSTD needs OpenEXR >= 3.4.
+EXR_COMPRESSIONS = MappingProxyType({
+    "zip": ExrCompression("ZIP", opencv_reads=True),
+    "zips": ExrCompression("ZIPS", opencv_reads=True),
+    "rle": ExrCompression("RLE", opencv_reads=True),
+    "none": ExrCompression("NO", opencv_reads=True),
+    "zstd": ExrCompression("ZSTD", opencv_reads=False),
+})
+DEFAULT_EXR_COMPRESSION = "zip"
 
 
 def _checked_exr_channels(channels: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -38,14 +61,18 @@ def _checked_exr_channels(channels: Mapping[str, np.ndarray]) -> dict[str, np.nd
     return out
 
 
-def encode_exr(channels: Mapping[str, np.ndarray]) -> bytes:
-    """EXR bytes (one part, scanlines, ZIP) of named (H, W) float32 / uint32 channels.
+def encode_exr(channels: Mapping[str, np.ndarray], compression: str = DEFAULT_EXR_COMPRESSION) -> bytes:
+    """EXR bytes (one part, scanlines, ZIP or ``compression`` of :data:`EXR_COMPRESSIONS`) of
+    named (H, W) float32 / uint32 channels.
 
     Values are stored bit-exactly (float32 as FLOAT, NaN and infinities included; uint32 as UINT).
     The file lists channels in alphabetical order (an EXR rule).
     """
+    if compression not in EXR_COMPRESSIONS:
+        raise ValueError(f"EXR compression must be one of {sorted(EXR_COMPRESSIONS)}, got {compression!r}")
     chans = _checked_exr_channels(channels)
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    comp = getattr(OpenEXR, f"{EXR_COMPRESSIONS[compression].openexr_name}_COMPRESSION")
+    header = {"compression": comp, "type": OpenEXR.scanlineimage}
     buf = io.BytesIO()
     OpenEXR.File(header, chans).write(buf)
     return buf.getvalue()

@@ -12,6 +12,9 @@ from scenegen.spec.model.limits import MAX_SPP
 #: Allowed values of the enumerations, in the order the docs list them.
 RENDER_VARIANTS = ("auto", "llvm_ad_rgb", "cuda_ad_rgb", "scalar_rgb")
 SAMPLERS = ("ldsampler", "multijitter", "stratified", "orthogonal", "independent")
+#: ``render.exr_compression`` (scenegen.dataset.codecs.exr.EXR_COMPRESSIONS; the spec does not
+#: import the dataset layer, tests/scenegen/dataset/test_exr_compression.py keeps the two equal).
+EXR_COMPRESSION_NAMES = ("zip", "zips", "rle", "none", "zstd")
 
 
 def effective_spp(sampler: str, spp: int) -> int:
@@ -55,4 +58,7 @@ class RenderSettings:
     sampler: str = param("ldsampler", unit="sampler", choices=SAMPLERS)  # Mitsuba sampler plugin
     motion_subframes: int = param(8, unit="sub-frames", lo=1, hi=256)  # sub-frames averaged when
     # objects move during the exposure
+    exr_compression: str = param("zip", unit="EXR compression", choices=EXR_COMPRESSION_NAMES,
+                                 omit_default=True)  # of a view's EXR files (truth, ids, linear):
+    # all lossless; 'none' and 'zstd' trade size for the writer's CPU (docs/dataset_format.md)
     where: Where | None = where_field()
