@@ -41,13 +41,8 @@ demo: setup
 	$(BIN)/scenegen render scenes/demo.yaml -o out/demo
 	$(BIN)/scenegen info out/demo
 
-# Two worker processes (pytest-xdist): most tests are single-threaded Python, and each worker
-# renders on its share of the cores (tests/conftest.py). worksteal: each worker starts on one
-# half of the suite in order (a module's fixtures are built once) and takes work from the other
-# when it runs out. TEST_WORKERS=0 runs in this process (no xdist).
-TEST_WORKERS ?= 2
 test: setup
-	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal
+	$(BIN)/python -m pytest -q
 
 # Open3D (the F-score benchmark's reference, in its own venv) needs Debian's libusb-1.0-0.
 bench-deps:
