@@ -3,8 +3,11 @@ folder lock, and a refused writer never deletes what it did not create. Whatever
 the live writer's dataset verifies and has the bytes of a run alone; concurrent ``--resume`` runs
 end with a dataset that verifies, 10 rounds of 10.
 
-Both processes render through a wrapper that sleeps before each view, so whichever takes the lock
-first still holds it when the other one reaches it (a sleep changes no byte)."""
+Both processes render through a wrapper that sleeps before each view; in the refused-writer test the
+wrapper also keeps the lock holder from closing the folder (which releases the lock) until the test
+has seen the other process exit, so the second writer meets a held lock however slowly a loaded
+machine starts it (without that wait, a holder that finished before the other process had even
+imported was not refused at all: "not empty" instead). A sleep or a wait changes no byte."""
 from __future__ import annotations
 
 import hashlib
@@ -31,23 +34,45 @@ views:
     orbit: {center: [0, 0, 0], radius_m: 2.0, elevations_deg: [30], count: 4}
 """
 SLOW = """
-import sys, time
+import os, sys, time
+from scenegen.dataset.writer import DatasetWriter
 from scenegen.pipeline import run
 real = run.render_view_data
 def slow(*a, **kw):
     time.sleep({sleep})
     return real(*a, **kw)
 run.render_view_data = slow
+gate = os.environ.get({gate_env!r})
+if gate:  # the lock is released in close(): hold it until the test creates the gate file
+    real_close = DatasetWriter.close
+    def gated_close(self):
+        t0 = time.monotonic()
+        while not os.path.exists(gate) and time.monotonic() - t0 < {gate_timeout_s}:
+            time.sleep(0.02)
+        return real_close(self)
+    DatasetWriter.close = gated_close
 from scenegen.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
+GATE_ENV = "SCENEGEN_TEST_CLOSE_GATE"
+GATE_TIMEOUT_S = 240  # a lock holder never waits longer (a broken test must not leave it hanging)
 
 
-def start(args, sleep: float = 0.0) -> subprocess.Popen:
-    code = SLOW.format(sleep=sleep)
-    return subprocess.Popen([sys.executable, "-c", code, *map(str, args)], cwd=ROOT, env=ENV,
+def start(args, sleep: float = 0.0, gate: Path | None = None) -> subprocess.Popen:
+    """``scenegen`` with ``args``, sleeping ``sleep`` s before each view; with ``gate``, a writer
+    that took the lock does not close its folder before the file ``gate`` exists."""
+    code = SLOW.format(sleep=sleep, gate_env=GATE_ENV, gate_timeout_s=GATE_TIMEOUT_S)
+    env = {**ENV, GATE_ENV: str(gate)} if gate is not None else ENV
+    return subprocess.Popen([sys.executable, "-c", code, *map(str, args)], cwd=ROOT, env=env,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def wait_for_either(a: subprocess.Popen, b: subprocess.Popen, timeout_s: float = GATE_TIMEOUT_S) -> None:
+    """Until one of the two processes has exited (or ``timeout_s``: the assertions then tell)."""
+    t0 = time.monotonic()
+    while a.poll() is None and b.poll() is None and time.monotonic() - t0 < timeout_s:
+        time.sleep(0.05)
 
 
 def finish(p: subprocess.Popen) -> tuple[int, str]:
@@ -85,10 +110,12 @@ def no_leftovers(parent: Path) -> bool:
 @pytest.mark.parametrize("delay_s", [0.1, 0.2, 0.4, 0.8])
 def test_a_refused_second_writer_leaves_the_live_writers_dataset_whole(tmp_path, spec_and_reference, delay_s):
     spec, reference = spec_and_reference
-    out = tmp_path / "out"
-    first = start(["render", spec, "-o", out, "-q"], sleep=0.5)
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    first = start(["render", spec, "-o", out, "-q"], sleep=0.5, gate=gate)
     time.sleep(delay_s)
-    second = start(["render", spec, "-o", out, "-q"], sleep=0.5)
+    second = start(["render", spec, "-o", out, "-q"], sleep=0.5, gate=gate)
+    wait_for_either(first, second)  # the refused one; the lock holder waits at close() meanwhile
+    gate.touch()
     (code1, err1), (code2, err2) = finish(first), finish(second)
     # whichever reaches the lock first writes; the other is refused while it runs (the lock names
     # its owner): one line, no traceback
