@@ -32,13 +32,12 @@ def projector_pixels(points_world, projector: Camera, projector_from_world: Rigi
     return uv.reshape(P.shape[:-1] + (2,))
 
 
-def projector_truth(points_world, normals_world, camera_center_world, projector: Camera,
-                    projector_from_world: Rigid3, visible, corner_points_world) -> ProjectorTruth:
-    """The truth of one view (module docstring). ``points_world``, ``normals_world``: (H, W, 3)
-    as stored (NaN = no surface); ``visible(center (3,), points (N, 3)) -> (N,) bool``: the
-    visibility cast of the scene at the view's time; ``corner_points_world`` (H + 1, W + 1, 3):
-    the points seen through the pixel corners (OpenCV (u, v) = (i - 0.5, j - 0.5), NaN = none),
-    for the clear masks."""
+def projector_lit(points_world, normals_world, camera_center_world, projector: Camera,
+                  projector_from_world: Rigid3, visible):
+    """(uv (H, W, 2) projector pixels, lit (H, W) bool, column, row (H, W) int): the stored points
+    projected through the projector, and whether the projector lights them (inside its image,
+    facing it on the camera's side, nothing between: ``visible``'s cast), as
+    :func:`projector_truth` states them (an active stereo frame needs only these)."""
     P = np.asarray(points_world, np.float64)
     N = np.asarray(normals_world, np.float64)
     H, W = P.shape[:2]
@@ -57,6 +56,19 @@ def projector_truth(points_world, normals_world, camera_center_world, projector:
         flat = lit.ravel()
         flat[idx] = np.asarray(seen, bool)
         lit = flat.reshape(H, W)
+    return uv, lit, col, row
+
+
+def projector_truth(points_world, normals_world, camera_center_world, projector: Camera,
+                    projector_from_world: Rigid3, visible, corner_points_world) -> ProjectorTruth:
+    """The truth of one view (module docstring). ``points_world``, ``normals_world``: (H, W, 3)
+    as stored (NaN = no surface); ``visible(center (3,), points (N, 3)) -> (N,) bool``: the
+    visibility cast of the scene at the view's time; ``corner_points_world`` (H + 1, W + 1, 3):
+    the points seen through the pixel corners (OpenCV (u, v) = (i - 0.5, j - 0.5), NaN = none),
+    for the clear masks."""
+    uv, lit, col, row = projector_lit(points_world, normals_world, camera_center_world, projector,
+                                      projector_from_world, visible)
+    center = projector_from_world.inverse().t
     column = np.where(lit, col, OUTSIDE).astype(np.int32)
     row_i = np.where(lit, row, OUTSIDE).astype(np.int32)
     gray = lambda a: np.where(a >= 0, binary_to_gray(np.maximum(a, 0)), OUTSIDE).astype(np.int32)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenegen.crossview.projector import projector_truth
+from scenegen.crossview.projector import projector_lit
 from scenegen.dataset.codecs import encode_png
 from scenegen.dataset.ir_stereo import encode_invalid, invalid_mask
 from scenegen.dataset.layout import STEREO_SIDES, stereo_path
@@ -59,8 +59,8 @@ def write_ir_frame(ctx, left: str, rect, passive, truths, states, *, spp: int, s
             ctx.write(stereo_path(left, key, side), encode_png(img))
         t = truths[side]
         points = np.where(t[TruthKind.VALID][..., None], t[TruthKind.POINTS_WORLD], np.nan)
-        lit_px = projector_truth(points, t[TruthKind.NORMALS_WORLD], pose.inverse().t, projector,
-                                 lit.projector_from_world, visible).lit
+        lit_px = projector_lit(points, t[TruthKind.NORMALS_WORLD], pose.inverse().t, projector,
+                               lit.projector_from_world, visible)[1]
         depth = np.where(t[TruthKind.VALID], t[TruthKind.DEPTH_Z], np.nan)
         mask = invalid_mask(depth, lit_px, states[side], (ctx.spec.crossview or CrossviewSpec()).ir_depth_range_m)
         ctx.write(stereo_path(left, "ir_invalid", side), encode_invalid(mask))

@@ -74,7 +74,7 @@ DROP = ("objects:\n  - {name: t, shape: box}\n  - {name: s, shape: sphere}\n"
 CASES = [
     *[(m.RenderSettings, k, "render: {}\n", lambda s, k=k: getattr(s.render, k), v)
       for k, v in (("spp", 16), ("max_depth", 3), ("seed", 5), ("variant", "scalar_rgb"),
-                   ("bit_depth", 16), ("sampler", "independent"), ("motion_subframes", 4))],
+                   ("bit_depth", 16), ("sampler", "independent"), ("motion_subframes", 4), ("exr_compression", "none"))],
     (m.SceneSpec, "description", "name: t\n", lambda s: s.description, "other"),
     (m.SceneSpec, "seed", "name: t\n", lambda s: s.seed, 3),
     (m.DiffuseMaterial, "color", "materials:\n  a: {type: diffuse}\n",
