@@ -49,7 +49,12 @@ def parse_sequence(node: Node, ctx: ParseContext) -> mt.SequenceSpec:
             if times[k] <= times[k - 1]:
                 raise items[k].error(f"expected strictly increasing timestamps, got {times[k]:g} "
                                      f"after {times[k - 1]:g}")
-    steps = tuple(_whole(f.get("flow_steps"), s) for s in read_floats(f, S, "flow_steps", None))
+    if "flow_steps" not in f:  # the default steps that pair frames (none for a single frame)
+        steps = tuple(s for s in read_floats(f, S, "flow_steps", None) if s < len(times))
+    elif f.get("flow_steps").items("a list of frame steps") == []:  # no flow asked for
+        steps = ()
+    else:
+        steps = tuple(_whole(f.get("flow_steps"), s) for s in read_floats(f, S, "flow_steps", None))
     for k, step in enumerate(steps):  # a step of the frame count or more pairs no frames
         if step >= len(times):
             raise f.get("flow_steps").items()[k].error(

@@ -200,3 +200,14 @@ def test_a_still_specs_moving_object_is_a_trajectory_from_mid_exposure(tmp_path)
     assert set(moves) == set(want) == {tl.objects[0].object_id}
     for a, b in zip(moves[tl.objects[0].object_id], want[tl.objects[0].object_id]):
         assert np.abs(np.asarray(a, float) - np.asarray(b, float)).max() < 1e-14
+
+
+def test_a_single_frame_sequence_keeps_no_default_flow_step_and_round_trips():
+    from scenegen.spec import parse_spec, to_yaml
+
+    text = ("cameras:\n  c: {size: [32, 24], fx: 30}\nobjects:\n  - {name: b, shape: sphere}\nviews:\n"
+            "  - camera: c\n    trajectory: {keyframes: [{time_s: 0, eye: [0, -3, 1], target: [0, 0, 0]}]}\n"
+            "sequence: {fps: 10, frames: 1}\n")
+    spec = parse_spec(text, file="one.yaml")
+    assert spec.sequence.flow_steps == ()
+    assert parse_spec(to_yaml(spec), file="again.yaml").sequence == spec.sequence
