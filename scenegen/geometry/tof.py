@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-#: c in m/s, exact (SI). The same value as scenegen.imaging.exposure.LIGHT_SPEED_M_S.
+#: c in m/s, exact (SI); the one statement of it (scenegen.imaging.exposure's photon energy uses it).
 SPEED_OF_LIGHT_M_S = 299_792_458.0
 #: The four phase offsets psi_j of the raw frames, radians.
 PHASE_OFFSETS_RAD = (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)

@@ -25,8 +25,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scenegen.geometry.tof import SPEED_OF_LIGHT_M_S
+
 PLANCK_J_S = 6.62607015e-34  # h, exact (SI 2019)
-LIGHT_SPEED_M_S = 299_792_458.0  # c, exact
+LIGHT_SPEED_M_S = SPEED_OF_LIGHT_M_S  # c, exact: stated once in scenegen.geometry.tof
 
 
 @dataclass(frozen=True, kw_only=True)
