@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: setup llvm bench-deps demo test bench clean
+.PHONY: setup llvm open3d-deps bench-deps demo test bench clean
 
 # Dr.Jit's LLVM back end needs libLLVM >= 16 (Debian's 15 aborts the process; see
 # docs/conventions.md). Debian and Ubuntu name libLLVM N's package libllvmN: any of these that is
@@ -35,7 +35,7 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install -q -e '.[dev,runners]'
 	touch $@
 
-setup: llvm $(VENV)/.installed
+setup: llvm open3d-deps $(VENV)/.installed
 
 demo: setup
 	$(BIN)/scenegen render scenes/demo.yaml -o out/demo
@@ -44,14 +44,17 @@ demo: setup
 test: setup
 	$(BIN)/python -m pytest -q
 
-# Open3D (the F-score benchmark's reference, in its own venv) needs Debian's libusb-1.0-0.
-bench-deps:
+# Open3D (the runners' extra, installed by setup: the object and TSDF-fusion runners and the F-score
+# benchmark's reference) loads Debian's libusb-1.0-0, which a fresh Debian machine lacks.
+open3d-deps:
 	@if command -v dpkg >/dev/null && dpkg -s libusb-1.0-0 >/dev/null 2>&1; then :; \
 	elif command -v apt-get >/dev/null; then \
-	  echo "installing libusb-1.0-0 (Debian) for Open3D in benchmarks/bench_fscore.py"; \
+	  echo "installing libusb-1.0-0 (Debian) for Open3D"; \
 	  $(SUDO) apt-get install -y -qq libusb-1.0-0 >/dev/null 2>&1 || \
 	  { $(SUDO) apt-get update -qq >/dev/null && $(SUDO) apt-get install -y -qq libusb-1.0-0 >/dev/null; }; \
-	else echo "no apt-get: install libusb-1.0 yourself or bench_fscore.py cannot import Open3D"; fi
+	else echo "warning: no apt-get: install libusb-1.0 yourself, else Open3D (runners, benchmarks) cannot be imported" >&2; fi
+
+bench-deps: open3d-deps
 
 bench: setup bench-deps
 	$(BIN)/python benchmarks/run.py
